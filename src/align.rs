@@ -1,0 +1,1 @@
+//! Similarity alignment of camera centres (helper "synth" implements).

@@ -1,0 +1,21 @@
+//! vgsel-colmap: view-graph selection for COLMAP databases.
+//!
+//! Data flows one way: [`database`] reads a COLMAP database, [`view_graph`] builds the graph of
+//! verified pairs, [`priors`] measure images and pairs, [`costs`] turn measurements into arc costs,
+//! [`network`] and [`solver`] find the min-cost flow of the paper (Shah, Chari, Narayanan),
+//! [`search`] picks the flow, and [`rewrite`] invalidates the unselected pairs, reversibly.
+//! [`prune`] runs that pipeline; [`report`] describes what it did.
+
+pub mod align;
+pub mod costs;
+pub mod database;
+pub mod graph_file;
+pub mod network;
+pub mod priors;
+pub mod prune;
+pub mod report;
+pub mod rewrite;
+pub mod search;
+pub mod solver;
+pub mod synth;
+pub mod view_graph;

@@ -1,0 +1,1 @@
+//! Synthetic COLMAP databases, deterministic from a seed (helper "synth" implements).
