@@ -1,1 +1,231 @@
-//! (in progress)
+//! From raw prior values to arc costs in [-1, 0].
+//!
+//! Each prior goes through g: optionally min-max scaled over all images (or pairs), then a
+//! trapezoid that maps it to a fitness in [low, high] ⊂ [0, 1]. An image's cost is minus the
+//! weighted mean of its priors' fitness times a node constant; a pair's cost is minus the weighted
+//! mean of its priors' fitness. Only encouraging costs (<= 0) are used, as the paper does, so the
+//! flow F stays the one free parameter.
+
+use crate::priors::PriorValues;
+use serde::Serialize;
+
+/// The normalisation g of one prior: a trapezoid with breakpoints k1..k6: `low` below k2, rising
+/// linearly to `high` on [k2, k3), `high` on [k3, k4], falling to `low` on (k4, k5), `low` above.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Trapezoid {
+    /// Min-max scale the raw values to [0, 1] over all images (or pairs) first.
+    pub minmax: bool,
+    pub k: [f64; 6],
+    pub high: f64,
+    pub low: f64,
+}
+
+impl Trapezoid {
+    /// Fitness rising from 0 at 0 to 1 at 1, on min-max scaled values: "more is better".
+    pub const RISE: Trapezoid = Trapezoid {
+        minmax: true,
+        k: [0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+        high: 1.0,
+        low: 0.0,
+    };
+
+    pub fn at(&self, x: f64) -> f64 {
+        let [_, k2, k3, k4, k5, _] = self.k;
+        let ramp = |from: f64, to: f64, x: f64| (x - from) / (to - from);
+        if x.is_nan() || x < k2 || x > k5 {
+            self.low
+        } else if x < k3 {
+            self.low + (self.high - self.low) * ramp(k2, k3, x)
+        } else if x <= k4 {
+            self.high
+        } else {
+            self.high + (self.low - self.high) * ramp(k4, k5, x)
+        }
+    }
+
+    /// Fitness of every value. When all values are equal the min-max scale is undefined; they
+    /// are then all equally fit and get `high`.
+    pub fn apply(&self, values: &[f64]) -> Vec<f64> {
+        if !self.minmax {
+            return values.iter().map(|&x| self.at(x)).collect();
+        }
+        let finite = values.iter().copied().filter(|x| x.is_finite());
+        let min = finite.clone().fold(f64::INFINITY, f64::min);
+        let max = finite.fold(f64::NEG_INFINITY, f64::max);
+        values
+            .iter()
+            .map(|&x| match max - min {
+                span if span > 0.0 => self.at((x - min) / span),
+                _ if x.is_finite() => self.high,
+                _ => self.low,
+            })
+            .collect()
+    }
+}
+
+/// How one prior enters the cost.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PriorModel {
+    pub name: &'static str,
+    pub g: Trapezoid,
+    pub weight: f64,
+}
+
+/// A preset: which priors, their g and weights.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CostModel {
+    pub image_priors: Vec<PriorModel>,
+    pub pair_priors: Vec<PriorModel>,
+    /// Scales image costs relative to pair costs (the authors ran 0, 0.5 and 1).
+    pub node_constant: f64,
+}
+
+impl CostModel {
+    /// The paper's `general` preset (section 5.2) with the authors' breakpoints and uniform
+    /// weights, restricted to the priors that need no relative pose.
+    pub fn general() -> CostModel {
+        let rise = |name| PriorModel {
+            name,
+            g: Trapezoid::RISE,
+            weight: 1.0,
+        };
+        CostModel {
+            image_priors: vec![rise("degree"), rise("track_fraction"), rise("clustering")],
+            pair_priors: vec![rise("inliers"), rise("overlap")],
+            node_constant: 1.0,
+        }
+    }
+}
+
+/// Costs of every image and pair, with each prior's fitness kept for reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Costs {
+    pub image_costs: Vec<f64>,
+    pub pair_costs: Vec<f64>,
+    pub image_fitness: Vec<PriorValues>,
+    pub pair_fitness: Vec<PriorValues>,
+}
+
+/// Applies the model to raw prior values (matched to the model by name; a model prior without
+/// values is an error of the caller and panics).
+pub fn compute(
+    model: &CostModel,
+    image_priors: &[PriorValues],
+    pair_priors: &[PriorValues],
+) -> Costs {
+    let (image_fitness, image_mean) = weighted_fitness(&model.image_priors, image_priors);
+    let (pair_fitness, pair_mean) = weighted_fitness(&model.pair_priors, pair_priors);
+    Costs {
+        image_costs: image_mean
+            .iter()
+            .map(|f| -(f * model.node_constant).clamp(0.0, 1.0))
+            .collect(),
+        pair_costs: pair_mean.iter().map(|f| -f.clamp(0.0, 1.0)).collect(),
+        image_fitness,
+        pair_fitness,
+    }
+}
+
+/// Each prior's fitness, and their weighted mean per item.
+fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorValues>, Vec<f64>) {
+    let fitness: Vec<PriorValues> = models
+        .iter()
+        .map(|m| {
+            let values = raw
+                .iter()
+                .find(|p| p.name == m.name)
+                .unwrap_or_else(|| panic!("no values for prior {}", m.name));
+            PriorValues {
+                name: m.name,
+                values: m.g.apply(&values.values),
+            }
+        })
+        .collect();
+    let n = fitness.first().map_or(0, |f| f.values.len());
+    let total_weight: f64 = models.iter().map(|m| m.weight).sum();
+    let mean = (0..n)
+        .map(|k| match total_weight {
+            w if w > 0.0 => {
+                models
+                    .iter()
+                    .zip(&fitness)
+                    .map(|(m, f)| m.weight * f.values[k])
+                    .sum::<f64>()
+                    / w
+            }
+            _ => 0.0,
+        })
+        .collect();
+    (fitness, mean)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trapezoid_pieces() {
+        // The authors' triangulation-angle g: rise 2 -> 45, flat to 90, fall to 120.
+        let g = Trapezoid {
+            minmax: false,
+            k: [0.0, 2.0, 45.0, 90.0, 120.0, 180.0],
+            high: 1.0,
+            low: 0.0,
+        };
+        assert_eq!(g.at(1.0), 0.0);
+        assert_eq!(g.at(2.0), 0.0);
+        assert!((g.at(23.5) - 0.5).abs() < 1e-12);
+        assert_eq!(g.at(45.0), 1.0);
+        assert_eq!(g.at(90.0), 1.0);
+        assert!((g.at(105.0) - 0.5).abs() < 1e-12);
+        assert_eq!(g.at(150.0), 0.0);
+        assert_eq!(g.at(f64::NAN), 0.0);
+    }
+
+    #[test]
+    fn minmax_rise_and_constant_values() {
+        assert_eq!(
+            Trapezoid::RISE.apply(&[10.0, 20.0, 15.0]),
+            vec![0.0, 1.0, 0.5]
+        );
+        assert_eq!(Trapezoid::RISE.apply(&[3.0, 3.0]), vec![1.0, 1.0]);
+    }
+
+    #[test]
+    fn weighted_mean_and_sign() {
+        let mut model = CostModel::general();
+        model.pair_priors[1].weight = 3.0;
+        let pairs = [
+            PriorValues {
+                name: "inliers",
+                values: vec![0.0, 10.0],
+            },
+            PriorValues {
+                name: "overlap",
+                values: vec![1.0, 0.0],
+            },
+        ];
+        let images = [
+            PriorValues {
+                name: "degree",
+                values: vec![1.0],
+            },
+            PriorValues {
+                name: "track_fraction",
+                values: vec![0.5],
+            },
+            PriorValues {
+                name: "clustering",
+                values: vec![0.0],
+            },
+        ];
+        let c = compute(&model, &images, &pairs);
+        assert_eq!(c.pair_costs, vec![-0.75, -0.25]);
+        assert_eq!(c.image_costs, vec![-1.0]);
+        assert!(c
+            .pair_costs
+            .iter()
+            .chain(&c.image_costs)
+            .all(|&x| (-1.0..=0.0).contains(&x)));
+    }
+}

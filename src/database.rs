@@ -16,7 +16,10 @@ pub fn pair_id(a: u32, b: u32) -> u64 {
 
 /// The two image ids (smaller first) of a pair_id.
 pub fn image_ids(pair_id: u64) -> (u32, u32) {
-    ((pair_id / MAX_NUM_IMAGES) as u32, (pair_id % MAX_NUM_IMAGES) as u32)
+    (
+        (pair_id / MAX_NUM_IMAGES) as u32,
+        (pair_id % MAX_NUM_IMAGES) as u32,
+    )
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -1,1 +1,150 @@
-//! (in progress)
+//! The prune pipeline up to the selection: read the database, build the view graph, compute the
+//! priors and costs, run the flow search. It writes nothing; [`crate::rewrite`] applies the plan.
+
+use crate::costs::{self, CostModel, Costs};
+use crate::database::{pair_id, Database, Image, VerifiedPair};
+use crate::network::{PairArc, SelectionProblem};
+use crate::priors::{self, Inputs};
+use crate::search::{self, FlowRule, SearchResult};
+use crate::view_graph::ViewGraph;
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use std::collections::HashMap;
+use std::time::Instant;
+
+pub struct Options {
+    pub min_num_matches: usize,
+    pub rule: FlowRule,
+    pub model: CostModel,
+}
+
+/// Seconds spent in each stage.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Timings {
+    pub read: f64,
+    pub priors: f64,
+    pub solve: f64,
+    pub write: f64,
+    pub total: f64,
+}
+
+/// Everything decided before writing.
+pub struct Plan {
+    pub images: Vec<Image>,
+    pub pairs: Vec<VerifiedPair>,
+    pub graph: ViewGraph,
+    pub costs: Costs,
+    pub search: SearchResult,
+    /// pair_ids of the view-graph edges the selection leaves out.
+    pub invalidate: Vec<u64>,
+    pub timings: Timings,
+}
+
+impl Plan {
+    /// The selected edges' verified pairs.
+    pub fn selected_pairs(&self) -> Vec<VerifiedPair> {
+        self.graph
+            .edges
+            .iter()
+            .zip(&self.search.selection.pairs)
+            .filter(|(_, &kept)| kept)
+            .map(|(e, _)| self.pairs[e.pair].clone())
+            .collect()
+    }
+}
+
+/// Reads the database and decides the selection. `stage` is told the name of each long step.
+pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Plan> {
+    let started = Instant::now();
+    let mut timings = Timings::default();
+
+    stage("reading images and verified pairs");
+    let images = db.images()?;
+    let cameras: HashMap<u32, (u32, u32)> = db
+        .cameras()?
+        .into_iter()
+        .map(|c| (c.camera_id, (c.width, c.height)))
+        .collect();
+    let pairs = db.verified_pairs()?;
+    if pairs.is_empty() {
+        bail!("no verified image pairs in two_view_geometries: run a COLMAP matcher first");
+    }
+    let graph = ViewGraph::build(&images, &pairs, options.min_num_matches);
+    if graph.edges.is_empty() {
+        bail!(
+            "no image pair has at least {} verified inliers (--min_num_matches)",
+            options.min_num_matches
+        );
+    }
+    let camera_of: HashMap<u32, u32> = images
+        .iter()
+        .map(|im| (im.image_id, im.camera_id))
+        .collect();
+    let image_sizes = graph
+        .image_ids
+        .iter()
+        .map(|id| {
+            let camera = camera_of[id];
+            cameras
+                .get(&camera)
+                .copied()
+                .with_context(|| format!("image {id} names camera {camera}, which does not exist"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    stage("reading keypoints");
+    let keypoints = graph
+        .image_ids
+        .iter()
+        .map(|&id| db.keypoints_xy(id))
+        .collect::<Result<Vec<_>>>()?;
+    timings.read = started.elapsed().as_secs_f64();
+
+    stage("computing priors");
+    let t = Instant::now();
+    let inputs = Inputs {
+        graph: &graph,
+        pairs: &pairs,
+        keypoints,
+        image_sizes,
+    };
+    let image_priors = priors::general_image_priors(&inputs);
+    let pair_priors = priors::general_pair_priors(&inputs);
+    let costs = costs::compute(&options.model, &image_priors, &pair_priors);
+    timings.priors = t.elapsed().as_secs_f64();
+
+    stage("solving the min-cost flow selection");
+    let t = Instant::now();
+    let problem = SelectionProblem {
+        image_costs: costs.image_costs.clone(),
+        pairs: graph
+            .edges
+            .iter()
+            .zip(&costs.pair_costs)
+            .map(|(e, &cost)| PairArc {
+                i: e.i,
+                j: e.j,
+                cost,
+            })
+            .collect(),
+    };
+    let search = search::search(&problem, &options.rule);
+    timings.solve = t.elapsed().as_secs_f64();
+
+    let invalidate = graph
+        .edges
+        .iter()
+        .zip(&search.selection.pairs)
+        .filter(|(_, &kept)| !kept)
+        .map(|(e, _)| pair_id(pairs[e.pair].image_id1, pairs[e.pair].image_id2))
+        .collect();
+    timings.total = started.elapsed().as_secs_f64();
+    Ok(Plan {
+        images,
+        pairs,
+        graph,
+        costs,
+        search,
+        invalidate,
+        timings,
+    })
+}

@@ -1,1 +1,176 @@
-//! (in progress)
+//! What a prune did: the JSON report (`--report FILE`) and the short summary on stderr.
+
+use crate::prune::{Plan, Timings};
+use crate::search::CriterionStatus;
+use crate::view_graph::{GraphStats, ViewGraph};
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// Version of the report's layout; bumped when a field changes meaning or disappears.
+pub const SCHEMA_VERSION: u32 = 1;
+
+#[derive(Debug, Serialize)]
+pub struct Report {
+    pub schema_version: u32,
+    pub tool_version: &'static str,
+    pub database_path: String,
+    /// Where the pruned database was written (the input itself unless `--output`); null on a dry run.
+    pub output_path: Option<String>,
+    pub dry_run: bool,
+    pub parameters: serde_json::Value,
+    pub flow: u64,
+    /// True when no flow met the criteria and the full view graph was kept.
+    pub capped: bool,
+    pub images_total: usize,
+    pub images_in_view_graph: usize,
+    pub images_selected: usize,
+    /// Names of images without any verified pair of at least `min_num_matches` inliers.
+    pub images_isolated: Vec<String>,
+    /// two_view_geometries rows with inliers (below `min_num_matches` too).
+    pub pairs_verified: usize,
+    /// View-graph edges (pairs with at least `min_num_matches` inliers).
+    pub pairs_total: usize,
+    pub pairs_selected: usize,
+    pub pairs_invalidated: usize,
+    pub graph_before: GraphStats,
+    pub graph_after: GraphStats,
+    pub criteria: Vec<CriterionStatus>,
+    pub priors: Vec<PriorSummary>,
+    pub timings: Timings,
+}
+
+/// Spread of one prior's fitness over all images or pairs, and over the selected ones.
+#[derive(Debug, Serialize)]
+pub struct PriorSummary {
+    pub name: &'static str,
+    pub applies_to: &'static str,
+    pub mean_fitness: f64,
+    pub mean_fitness_selected: f64,
+}
+
+impl Report {
+    pub fn new(
+        plan: &Plan,
+        database_path: String,
+        output_path: Option<String>,
+        parameters: serde_json::Value,
+    ) -> Report {
+        let selection = &plan.search.selection;
+        let after = ViewGraph::build(&plan.images, &plan.selected_pairs(), 1);
+        let names: HashMap<u32, &str> = plan
+            .images
+            .iter()
+            .map(|im| (im.image_id, im.name.as_str()))
+            .collect();
+        let mut isolated: Vec<String> = plan
+            .graph
+            .isolated
+            .iter()
+            .map(|id| names[id].to_string())
+            .collect();
+        isolated.sort();
+        let summarise = |fitness: &[crate::priors::PriorValues], kept: &[bool], applies_to| {
+            fitness
+                .iter()
+                .map(|f| PriorSummary {
+                    name: f.name,
+                    applies_to,
+                    mean_fitness: mean(f.values.iter().copied()),
+                    mean_fitness_selected: mean(
+                        f.values
+                            .iter()
+                            .zip(kept)
+                            .filter(|(_, &k)| k)
+                            .map(|(&v, _)| v),
+                    ),
+                })
+                .collect::<Vec<_>>()
+        };
+        let mut priors = summarise(&plan.costs.image_fitness, &selection.images, "images");
+        priors.extend(summarise(
+            &plan.costs.pair_fitness,
+            &selection.pairs,
+            "pairs",
+        ));
+        Report {
+            schema_version: SCHEMA_VERSION,
+            tool_version: env!("CARGO_PKG_VERSION"),
+            dry_run: output_path.is_none(),
+            database_path,
+            output_path,
+            parameters,
+            flow: selection.flow,
+            capped: plan.search.capped,
+            images_total: plan.images.len(),
+            images_in_view_graph: plan.graph.num_vertices(),
+            images_selected: selection.images.iter().filter(|&&s| s).count(),
+            images_isolated: isolated,
+            pairs_verified: plan.pairs.len(),
+            pairs_total: plan.graph.edges.len(),
+            pairs_selected: selection.pairs.iter().filter(|&&s| s).count(),
+            pairs_invalidated: plan.invalidate.len(),
+            graph_before: plan.graph.stats(),
+            graph_after: after.stats(),
+            criteria: plan.search.criteria.clone(),
+            priors,
+            timings: plan.timings.clone(),
+        }
+    }
+
+    /// Two or three lines for a person.
+    pub fn summary(&self) -> String {
+        let pct = |a: usize, b: usize| {
+            if b == 0 {
+                0.0
+            } else {
+                100.0 * a as f64 / b as f64
+            }
+        };
+        let binding = self
+            .criteria
+            .iter()
+            .find(|c| c.binding)
+            .map(|c| c.name.as_str());
+        let why = match (self.capped, binding) {
+            (true, _) => "no flow met the criteria: full graph kept".to_string(),
+            (false, Some(name)) => format!("set by the {name} criterion"),
+            (false, None) => "fixed by --flow".to_string(),
+        };
+        let mut s = format!(
+            "selected {} of {} pairs ({:.1}%) and {} of {} images at flow F = {} ({why})\n",
+            self.pairs_selected,
+            self.pairs_total,
+            pct(self.pairs_selected, self.pairs_total),
+            self.images_selected,
+            self.images_in_view_graph,
+            self.flow,
+        );
+        s += &format!(
+            "components: {} before, {} after; {} pairs invalidated{}",
+            self.graph_before.components,
+            self.graph_after.components,
+            self.pairs_invalidated,
+            if self.dry_run {
+                " (dry run: nothing written)"
+            } else {
+                ""
+            }
+        );
+        if !self.images_isolated.is_empty() {
+            s += &format!(
+                "\n{} images have no verified pair and were left alone",
+                self.images_isolated.len()
+            );
+        }
+        s
+    }
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}

@@ -28,3 +28,11 @@ pub fn apply(_db: &mut Database, _invalidate: &[u64], _run: &RunRecord) -> Resul
 pub fn restore(_db: &mut Database) -> Result<usize> {
     todo!()
 }
+
+pub fn copy_database(
+    _src: &std::path::Path,
+    _dst: &std::path::Path,
+    _overwrite: bool,
+) -> Result<()> {
+    todo!()
+}

@@ -1,0 +1,16 @@
+//! Image prior: 1 - local clustering coefficient. The paper adds the clustering coefficient to
+//! favour images that connect otherwise separate groups (point-of-view bias in photo
+//! collections); such bridging images have a *low* coefficient, so the fitness is its complement.
+
+use super::PriorValues;
+use crate::view_graph::ViewGraph;
+
+pub fn compute(graph: &ViewGraph) -> PriorValues {
+    let values = (0..graph.num_vertices())
+        .map(|v| 1.0 - graph.clustering_coefficient(v))
+        .collect();
+    PriorValues {
+        name: "clustering",
+        values,
+    }
+}

@@ -1,0 +1,14 @@
+//! Image prior: degree in the view graph. Well-connected images support long tracks.
+
+use super::PriorValues;
+use crate::view_graph::ViewGraph;
+
+pub fn compute(graph: &ViewGraph) -> PriorValues {
+    let values = (0..graph.num_vertices())
+        .map(|v| graph.degree(v) as f64)
+        .collect();
+    PriorValues {
+        name: "degree",
+        values,
+    }
+}

@@ -1,0 +1,71 @@
+//! Image prior: fraction of an image's keypoints that are inliers of at least one view-graph
+//! edge, i.e. that take part in a track. Images with many observations anchor the reconstruction.
+
+use super::{Inputs, PriorValues};
+
+pub fn compute(inputs: &Inputs) -> PriorValues {
+    let mut in_track: Vec<Vec<bool>> = inputs
+        .keypoints
+        .iter()
+        .map(|k| vec![false; k.len()])
+        .collect();
+    for (edge, e) in inputs.graph.edges.iter().enumerate() {
+        for [a, b] in inputs.edge_inliers(edge) {
+            in_track[e.i as usize][a as usize] = true;
+            in_track[e.j as usize][b as usize] = true;
+        }
+    }
+    let values = in_track
+        .iter()
+        .map(|used| match used.len() {
+            0 => 0.0,
+            n => used.iter().filter(|&&u| u).count() as f64 / n as f64,
+        })
+        .collect();
+    PriorValues {
+        name: "track_fraction",
+        values,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::database::{Image, VerifiedPair};
+    use crate::view_graph::ViewGraph;
+
+    #[test]
+    fn counts_each_keypoint_once_across_pairs() {
+        let images: Vec<Image> = (1..=3)
+            .map(|id| Image {
+                image_id: id,
+                name: id.to_string(),
+                camera_id: 1,
+            })
+            .collect();
+        // Pair ids are stored with the larger image first here to exercise orientation.
+        let pairs = vec![
+            VerifiedPair {
+                image_id1: 1,
+                image_id2: 2,
+                config: 2,
+                inliers: vec![[0, 1], [1, 2]],
+            },
+            VerifiedPair {
+                image_id1: 1,
+                image_id2: 3,
+                config: 2,
+                inliers: vec![[0, 3]],
+            },
+        ];
+        let graph = ViewGraph::build(&images, &pairs, 1);
+        let inputs = Inputs {
+            graph: &graph,
+            pairs: &pairs,
+            keypoints: vec![vec![[0.0; 2]; 4], vec![[0.0; 2]; 3], vec![[0.0; 2]; 8]],
+            image_sizes: vec![(10, 10); 3],
+        };
+        let v = compute(&inputs).values;
+        assert_eq!(v, vec![2.0 / 4.0, 2.0 / 3.0, 1.0 / 8.0]);
+    }
+}
