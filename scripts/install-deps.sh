@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the system packages vgsel-colmap's tests, demo and benchmarks use (Debian/Ubuntu):
+# COLMAP 3.8 (real mapper runs in tests) and sqlite3 (inspection in scripts).
+# Does nothing for packages already installed; needs root or sudo otherwise.
+set -euo pipefail
+packages=(colmap sqlite3)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+echo "installing: ${missing[*]}" >&2
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
