@@ -18,4 +18,5 @@ pub mod rewrite;
 pub mod search;
 pub mod solver;
 pub mod synth;
+pub mod synthetic_graph;
 pub mod view_graph;
