@@ -73,9 +73,10 @@ fn local_edges(
         }
         j = match arrangement {
             Arrangement::Loop => j.rem_euclid(n),
-            Arrangement::Linear if (0..n).contains(&j) => j,
-            // Far offsets near the ends of a line: fall back to a uniform partner.
-            Arrangement::Linear => rng.gen_range(0..n),
+            // Offsets past an end of the line reflect back into it.
+            Arrangement::Linear if j < 0 => (-j).min(n - 1),
+            Arrangement::Linear if j >= n => (2 * (n - 1) - j).max(0),
+            Arrangement::Linear => j,
         };
         if i == j {
             continue;
