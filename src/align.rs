@@ -90,7 +90,10 @@ pub fn umeyama_ransac(
     iterations: usize,
     seed: u64,
 ) -> Result<(Similarity, Vec<bool>)> {
-    ensure!(src.len() == dst.len(), "umeyama_ransac: point counts differ");
+    ensure!(
+        src.len() == dst.len(),
+        "umeyama_ransac: point counts differ"
+    );
     ensure!(src.len() >= 3, "umeyama_ransac: needs at least 3 points");
     let inliers_of = |sim: &Similarity| -> Vec<bool> {
         src.iter()
@@ -154,9 +157,11 @@ pub fn rotation_error_deg(
     estimated: &Rotation3<f64>,
     truth: &Rotation3<f64>,
 ) -> f64 {
-    (estimated * sim.rotation.inverse())
-        .angle_to(truth)
-        .to_degrees()
+    // atan2 of the relative quaternion: acos of the trace loses precision near zero.
+    let rel = UnitQuaternion::from_rotation_matrix(
+        &(truth.inverse() * estimated * sim.rotation.inverse()),
+    );
+    (2.0 * rel.imag().norm().atan2(rel.w.abs())).to_degrees()
 }
 
 /// One image of a COLMAP model (x_cam = rotation * X + translation).

@@ -252,13 +252,7 @@ fn sample_surface(
         Surface::Box { centre, half, yaw } => {
             let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), *yaw);
             // Faces: +x, -x, +y, -y, +z with their areas.
-            let faces: [(usize, f64); 5] = [
-                (0, 1.0),
-                (0, -1.0),
-                (1, 1.0),
-                (1, -1.0),
-                (2, 1.0),
-            ];
+            let faces: [(usize, f64); 5] = [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0)];
             let area = |axis: usize| {
                 let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
                 half[a] * half[b]
@@ -284,11 +278,7 @@ fn sample_surface(
                 let mut normal = Vector3::zeros();
                 normal[axis] = sign;
                 let perturbed = normal
-                    + Vector3::new(
-                        jitter.sample(rng),
-                        jitter.sample(rng),
-                        jitter.sample(rng),
-                    );
+                    + Vector3::new(jitter.sample(rng), jitter.sample(rng), jitter.sample(rng));
                 out.push((centre + rot * local, (rot * perturbed).normalize()));
             }
         }
@@ -585,9 +575,8 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
         )?;
         let mut ins_image =
             tx.prepare("INSERT INTO images(image_id, name, camera_id) VALUES (?1, ?2, ?3)")?;
-        let mut ins_kp = tx.prepare(
-            "INSERT INTO keypoints(image_id, rows, cols, data) VALUES (?1, ?2, 6, ?3)",
-        )?;
+        let mut ins_kp =
+            tx.prepare("INSERT INTO keypoints(image_id, rows, cols, data) VALUES (?1, ?2, 6, ?3)")?;
         let mut ins_desc = tx.prepare(
             "INSERT INTO descriptors(image_id, rows, cols, data) VALUES (?1, ?2, 128, ?3)",
         )?;
@@ -612,8 +601,8 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
             }
         }
 
-        let mut ins_match = tx
-            .prepare("INSERT INTO matches(pair_id, rows, cols, data) VALUES (?1, ?2, 2, ?3)")?;
+        let mut ins_match =
+            tx.prepare("INSERT INTO matches(pair_id, rows, cols, data) VALUES (?1, ?2, 2, ?3)")?;
         let mut ins_tvg = tx.prepare(
             "INSERT INTO two_view_geometries(pair_id, rows, cols, data, config, F, E, H, qvec, tvec) \
              VALUES (?1, ?2, 2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
@@ -746,7 +735,11 @@ pub fn write_gt_model(gt: &GroundTruth, dir: &Path) -> Result<()> {
          #   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n\
          # Number of cameras: 1\n",
     );
-    write!(cameras, "{} SIMPLE_RADIAL {} {}", c.camera_id, c.width, c.height)?;
+    write!(
+        cameras,
+        "{} SIMPLE_RADIAL {} {}",
+        c.camera_id, c.width, c.height
+    )?;
     for p in &c.params {
         write!(cameras, " {p}")?;
     }

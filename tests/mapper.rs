@@ -103,7 +103,11 @@ fn map_and_check(dir: &Path, db: &Path, gt: &GroundTruth) {
         eval.extent,
         eval.max_rotation_error_deg()
     );
-    assert!(eval.missing.is_empty(), "not registered: {:?}", eval.missing);
+    assert!(
+        eval.missing.is_empty(),
+        "not registered: {:?}",
+        eval.missing
+    );
     assert!(
         eval.max_position_error() < 0.05 * eval.extent,
         "position errors: {:?}",
