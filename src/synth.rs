@@ -34,7 +34,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use rusqlite::{params, Connection};
-use std::collections::{BTreeMap, HashSet};
+use std::collections::HashSet;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -370,6 +370,9 @@ fn build_cameras(spec: &SceneSpec, rng: &mut ChaCha8Rng) -> Vec<GtImage> {
         .collect()
 }
 
+/// Keypoint in image a, keypoint in image b (a < b), same 3D point.
+type Correspondence = (u32, u32, bool);
+
 /// Keypoints of one image: positions and, for each visible point, its keypoint index.
 struct ImageObservations {
     keypoints: Vec<[f32; 2]>,
@@ -514,8 +517,8 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
         .map(|im| observe(spec, im, &points, &mut rng))
         .collect();
 
-    // Observations grouped by appearance, then correspondences per pair: the cost is the size of
-    // the output, not pairs x points.
+    // Observations grouped by appearance; correspondences are then gathered per first image
+    // (below), so time is the size of the output, not pairs x points, and memory one image's.
     let num_appearances = points.iter().map(|p| p.appearance + 1).max().unwrap_or(0) as usize;
     let mut by_appearance: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); num_appearances];
     for (ii, obs) in observations.iter().enumerate() {
@@ -523,27 +526,6 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
             by_appearance[points[pi as usize].appearance as usize].push((ii as u32, kp, pi));
         }
     }
-    // (image index a < b) -> (kp in a, kp in b, same 3D point)
-    let mut correspondences: BTreeMap<(u32, u32), Vec<(u32, u32, bool)>> = BTreeMap::new();
-    for group in &by_appearance {
-        for (x, &(ia, ka, pa)) in group.iter().enumerate() {
-            for &(ib, kb, pb) in &group[x + 1..] {
-                if ia == ib {
-                    continue;
-                }
-                let entry = if ia < ib {
-                    (ia, ib, ka, kb)
-                } else {
-                    (ib, ia, kb, ka)
-                };
-                correspondences
-                    .entry((entry.0, entry.1))
-                    .or_default()
-                    .push((entry.2, entry.3, pa == pb));
-            }
-        }
-    }
-
     let mut conn = Connection::open(database_path)
         .with_context(|| format!("creating {}", database_path.display()))?;
     conn.execute_batch(include_str!("../sql/colmap-3.8.sql"))
@@ -619,28 +601,39 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
             Ok(())
         };
         let n = images.len() as u32;
-        let mut next = correspondences.iter().peekable();
+        let mut buckets: Vec<Vec<Correspondence>> = vec![Vec::new(); n as usize];
         for a in 0..n {
+            for bucket in &mut buckets {
+                bucket.clear();
+            }
+            for &(pa, ka) in &observations[a as usize].seen {
+                let group = &by_appearance[points[pa as usize].appearance as usize];
+                for &(ib, kb, pb) in group {
+                    if ib > a {
+                        buckets[ib as usize].push((ka, kb, pa == pb));
+                    }
+                }
+            }
             for b in a + 1..n {
                 let id1 = images[a as usize].image_id as u64;
                 let id2 = images[b as usize].image_id as u64;
                 let pair_id = MAX_NUM_IMAGES * id1 + id2;
-                let corr = match next.peek() {
-                    Some((&key, _)) if key == (a, b) => next.next().unwrap().1,
-                    _ => {
-                        if spec.all_pairs {
-                            write_failed(&mut ins_match, &mut ins_tvg, pair_id, &[])?;
-                        }
-                        continue;
+                let corr = &buckets[b as usize];
+                if corr.is_empty() {
+                    if spec.all_pairs {
+                        write_failed(&mut ins_match, &mut ins_tvg, pair_id, &[])?;
                     }
-                };
+                    continue;
+                }
                 // One-to-one, as COLMAP's cross-checked matching produces.
                 let mut used1 = HashSet::new();
                 let mut used2 = HashSet::new();
                 let mut matches: Vec<[u32; 2]> = Vec::new();
                 let mut true_ones: Vec<[u32; 2]> = Vec::new();
                 for &(k1, k2, same) in corr {
-                    if used1.insert(k1) && used2.insert(k2) {
+                    if !used1.contains(&k1) && !used2.contains(&k2) {
+                        used1.insert(k1);
+                        used2.insert(k2);
                         matches.push([k1, k2]);
                         if same {
                             true_ones.push([k1, k2]);

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 use vgsel_colmap::align::{evaluate, read_text_model_images};
-use vgsel_colmap::synth::{generate, GroundTruth, SceneSpec};
+use vgsel_colmap::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
 
 fn colmap() -> Command {
     let ok = Command::new("colmap")
@@ -134,4 +134,31 @@ fn mapper_reconstructs_pruned_synthetic_scene() {
     let (db, gt) = scene(dir.path());
     prune(&db);
     map_and_check(dir.path(), &db, &gt);
+}
+
+#[test]
+fn colmap_reads_the_ground_truth_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_db, gt) = scene(dir.path());
+    let model = dir.path().join("gt");
+    let bin = dir.path().join("gt_bin");
+    let back = dir.path().join("gt_txt");
+    write_gt_model(&gt, &model).unwrap();
+    std::fs::create_dir_all(&bin).unwrap();
+    std::fs::create_dir_all(&back).unwrap();
+    for (input, output, kind) in [(&model, &bin, "BIN"), (&bin, &back, "TXT")] {
+        let mut cmd = colmap();
+        cmd.arg("model_converter")
+            .arg("--input_path")
+            .arg(input)
+            .arg("--output_path")
+            .arg(output)
+            .args(["--output_type", kind]);
+        run(cmd);
+    }
+    let images = read_text_model_images(&back).unwrap();
+    let eval = evaluate(&images, &gt.model_images()).unwrap();
+    assert!(eval.missing.is_empty());
+    assert!(eval.max_position_error() < 1e-6 * eval.extent);
+    assert!(eval.max_rotation_error_deg() < 1e-4);
 }
