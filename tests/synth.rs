@@ -288,8 +288,8 @@ fn inliers_satisfy_the_stored_epipolar_geometry() {
             let fx1 = f * x1;
             let ftx2 = f.transpose() * x2;
             let num = x2.dot(&fx1);
-            let sampson = num * num
-                / (fx1.x * fx1.x + fx1.y * fx1.y + ftx2.x * ftx2.x + ftx2.y * ftx2.y);
+            let sampson =
+                num * num / (fx1.x * fx1.x + fx1.y * fx1.y + ftx2.x * ftx2.x + ftx2.y * ftx2.y);
             // Noise 0.5 px: Sampson distance (squared px) stays far below 4 px^2.
             assert!(sampson < 4.0, "pair {id1}-{id2}: sampson {sampson}");
             checked += 1;
