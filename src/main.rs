@@ -8,7 +8,7 @@ use std::time::Instant;
 use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::database::Database;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
-use vgsel_colmap::{graph_file, prune, report::Report, rewrite};
+use vgsel_colmap::{graph_file, prune, report::Report, rewrite, synth};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -46,6 +46,43 @@ enum Command {
     Inspect(InspectArgs),
     /// Run the selection solver on a plain-text graph (benchmarks, solver-only users).
     Solve(SolveArgs),
+    /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
+    #[command(subcommand)]
+    Generate(GenerateCommand),
+}
+
+#[derive(Subcommand)]
+enum GenerateCommand {
+    /// A matched COLMAP 3.8 database of cameras orbiting a synthetic scene, with its ground truth.
+    Database(GenerateDatabaseArgs),
+}
+
+#[derive(Args)]
+struct GenerateDatabaseArgs {
+    /// The database to create (must not exist).
+    #[arg(long, value_name = "DB")]
+    output: PathBuf,
+    /// Also write the ground-truth poses here as a COLMAP text model.
+    #[arg(
+        long = "ground_truth",
+        visible_alias = "ground-truth",
+        value_name = "DIR"
+    )]
+    ground_truth: Option<PathBuf>,
+    #[arg(
+        long = "num_images",
+        visible_alias = "num-images",
+        default_value_t = 24
+    )]
+    num_images: usize,
+    #[arg(
+        long = "num_points",
+        visible_alias = "num-points",
+        default_value_t = 6000
+    )]
+    num_points: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
 }
 
 #[derive(Args)]
@@ -167,6 +204,7 @@ fn main() -> ExitCode {
         Command::Restore(args) => run_restore(&args, quiet),
         Command::Inspect(args) => run_inspect(&args),
         Command::Solve(args) => run_solve(&args),
+        Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -375,5 +413,20 @@ fn run_solve(args: &SolveArgs) -> Result<()> {
         "solve_seconds": solve_seconds,
     });
     println!("{value}");
+    Ok(())
+}
+
+fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
+    let spec = synth::SceneSpec {
+        num_images: args.num_images,
+        num_points: args.num_points,
+        seed: args.seed,
+        ..Default::default()
+    };
+    let gt = synth::generate(&spec, &args.output)?;
+    if let Some(dir) = &args.ground_truth {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        synth::write_gt_model(&gt, dir)?;
+    }
     Ok(())
 }
