@@ -353,3 +353,65 @@ fn copy_database_copies_and_refuses_to_clobber() {
         dump(&orig, "two_view_geometries")
     );
 }
+
+/// 1,000 images / 100K verified pairs: reading and rewriting must take seconds, not minutes.
+/// `cargo test --release --test rewrite -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn large_database_is_fast_enough() {
+    use rusqlite::params;
+    use std::time::Instant;
+    let dir = tempfile::tempdir().unwrap();
+    let path = empty_db(dir.path(), "big.db", Layout::V38);
+    let mut conn = Connection::open(&path).unwrap();
+    let tx = conn.transaction().unwrap();
+    tx.execute(
+        "INSERT INTO cameras (camera_id, model, width, height, params, prior_focal_length) VALUES (1, 0, 640, 480, ?1, 0)",
+        [f64_blob(&[500.0, 320.0, 240.0])],
+    )
+    .unwrap();
+    let kp = f32_blob(&vec![1.0; 2 * 1000]);
+    for i in 1..=1000u32 {
+        tx.execute(
+            "INSERT INTO images (image_id, name, camera_id) VALUES (?1, ?2, 1)",
+            params![i, format!("{i}.jpg")],
+        )
+        .unwrap();
+        tx.execute(
+            "INSERT INTO keypoints (image_id, rows, cols, data) VALUES (?1, 1000, 2, ?2)",
+            params![i, kp],
+        )
+        .unwrap();
+    }
+    let inliers = pairs_blob(&(0..50).map(|k| [k, k + 1]).collect::<Vec<_>>());
+    let f = f64_blob(&[0.5; 9]);
+    let mut all = Vec::new();
+    'outer: for a in 1..=1000u32 {
+        for b in a + 1..=1000 {
+            let id = pair_id(a, b);
+            all.push(id);
+            tx.execute("INSERT INTO two_view_geometries (pair_id, rows, cols, data, config, F, E, H, qvec, tvec) VALUES (?1, 50, 2, ?2, 2, ?3, ?3, ?3, NULL, NULL)", params![id as i64, inliers, f]).unwrap();
+            if all.len() == 100_000 {
+                break 'outer;
+            }
+        }
+    }
+    tx.commit().unwrap();
+    drop(conn);
+
+    let t = Instant::now();
+    let mut db = Database::open(&path).unwrap();
+    assert_eq!(db.verified_pairs().unwrap().len(), 100_000);
+    let read = t.elapsed();
+    let t = Instant::now();
+    apply(&mut db, &all[..90_000], &run(10_000)).unwrap();
+    let pruned = t.elapsed();
+    let t = Instant::now();
+    assert_eq!(db.verified_pairs().unwrap().len(), 100_000);
+    let read_pruned = t.elapsed();
+    let t = Instant::now();
+    assert_eq!(restore(&mut db).unwrap(), 90_000);
+    let restored = t.elapsed();
+    eprintln!("verified_pairs {read:?}, apply {pruned:?}, verified_pairs after {read_pruned:?}, restore {restored:?}");
+    assert!(read + pruned + read_pruned + restored < Duration::from_secs(60));
+}
