@@ -111,6 +111,8 @@ pub fn fixture(layout: Layout) -> (TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let path = empty_db(dir.path(), "database.db", layout);
     let conn = Connection::open(&path).unwrap();
+    // One transaction: one fsync instead of one per row.
+    conn.execute_batch("BEGIN").unwrap();
     let latest = layout == Layout::Latest;
     conn.execute(
         "INSERT INTO cameras (camera_id, model, width, height, params, prior_focal_length) VALUES (1, 2, 640, 480, ?1, 0), (2, 1, 800, 600, ?2, 1)",
@@ -208,6 +210,7 @@ pub fn fixture(layout: Layout) -> (TempDir, PathBuf) {
         params![pair_id(1, 4) as i64],
     )
     .unwrap();
+    conn.execute_batch("COMMIT").unwrap();
     (dir, path)
 }
 
