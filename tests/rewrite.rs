@@ -415,3 +415,41 @@ fn large_database_is_fast_enough() {
     eprintln!("verified_pairs {read:?}, apply {pruned:?}, verified_pairs after {read_pruned:?}, restore {restored:?}");
     assert!(read + pruned + read_pruned + restored < Duration::from_secs(60));
 }
+
+/// Number of pairs `colmap mapper` (3.8) loads from `path` ("Loading matches... N"), or None
+/// when colmap is not installed. The mapper itself then fails: the fixture's keypoints are fake.
+fn colmap_loaded_pairs(path: &Path) -> Option<usize> {
+    let dir = tempfile::tempdir().unwrap();
+    let run = std::process::Command::new("colmap")
+        .args(["mapper", "--database_path"])
+        .arg(path)
+        .arg("--image_path")
+        .arg(dir.path())
+        .arg("--output_path")
+        .arg(dir.path())
+        .output()
+        .ok()?;
+    let log =
+        String::from_utf8_lossy(&run.stdout).to_string() + &String::from_utf8_lossy(&run.stderr);
+    let n = log
+        .lines()
+        .find_map(|l| l.strip_prefix("Loading matches... "))
+        .unwrap_or_else(|| panic!("unexpected colmap output: {log}"));
+    Some(n.split_whitespace().next().unwrap().parse().unwrap())
+}
+
+/// COLMAP 3.8 itself loads a pruned database (extra tables, NULL geometry columns) and uses only
+/// the kept pairs; after restore it uses all of them again. Skipped without `colmap`.
+#[test]
+fn colmap_38_sees_only_the_kept_pairs_if_installed() {
+    let (_dir, path) = fixture(Layout::V38);
+    let Some(all) = colmap_loaded_pairs(&path) else {
+        eprintln!("colmap not installed; skipped");
+        return;
+    };
+    assert_eq!(all, 4);
+    prune(&path, &A);
+    assert_eq!(colmap_loaded_pairs(&path), Some(2));
+    restore(&mut Database::open(&path).unwrap()).unwrap();
+    assert_eq!(colmap_loaded_pairs(&path), Some(4));
+}
