@@ -337,7 +337,7 @@ impl ParametricSolver {
             path_arcs += 1;
             let arc = self.arcs[a as usize];
             v = self.arcs[arc.rev as usize].head as usize;
-            if path_arcs == 1 && v + 1 == arc.head as usize && v % 2 == 1 && arc.cap > 0 {
+            if path_arcs == 1 && v + 1 == arc.head as usize && v & 1 == 1 && arc.cap > 0 {
                 direct_image = ((v - 1) / 2) as u32;
             }
         }
@@ -358,7 +358,7 @@ impl ParametricSolver {
         self.arcs[r].cap += 1;
         let u = self.arcs[r].head as usize;
         let v = arc.head as usize;
-        if u % 2 == 1 {
+        if u & 1 == 1 {
             if v > u {
                 // image arc in_i -> out_i: flow is now the reverse arc's capacity
                 if self.arcs[r].cap == 1 {
@@ -436,7 +436,7 @@ impl ParametricSolver {
                     heap_update(heap, nodes, v as u32, nd);
                 }
             }
-            if u % 2 == 0 {
+            if u & 1 == 0 {
                 // out_u -> t, unbounded, cost 0
                 let nt = &mut nodes[t];
                 let nd = pu - nt.pi;

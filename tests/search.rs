@@ -124,15 +124,15 @@ fn full_graph_at_flow_e_and_capped_search() {
     assert_eq!(r.selection.images, vec![true; 21]);
     assert_eq!(r.selection.pairs, vec![true; 60]);
     assert_eq!(r.selection.flow, 60);
-    let mut deg = vec![0.0; 21];
+    let mut deg = [0.0; 21];
     let mut cost = 0.0;
     for e in &q.pairs {
         deg[e.i as usize] += 1.0;
         deg[e.j as usize] += 1.0;
         cost += e.cost;
     }
-    for i in 0..21 {
-        cost += deg[i] * q.image_costs[i];
+    for (d, c) in deg.iter().zip(&q.image_costs) {
+        cost += d * c;
     }
     assert!((r.selection.cost - cost).abs() < 1e-9);
     let si = status(&r, "images");

@@ -323,7 +323,7 @@ fn whole_run_to_max_flow_is_monotone_and_certified() {
         steps += 1;
         peak_pairs = peak_pairs.max(s.pairs_selected());
         s.check_optimality().unwrap();
-        if steps % 97 == 0 {
+        if steps.is_multiple_of(97) {
             certify(&p, &s);
         }
     }
