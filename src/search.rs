@@ -1,7 +1,28 @@
 //! Choice of the flow F: fixed, or the smallest F whose selection meets the criteria.
-//! (helper "solver" implements)
+//!
+//! One [`ParametricSolver`] run gives the min-cost selection for F = 1, 2, ... in turn, so the
+//! criteria search simply augments until the selection meets both targets: the F found is the
+//! exact smallest such F (the paper doubles F and bisects, with one full solve per probe).
+//!
+//! Targets, with n = number of images in the problem: images selected >= ceil(A n) and pairs
+//! selected >= min(ceil(B n), |E|).
+//!
+//! When no F meets both targets the full graph is kept (`capped`): every image and every pair
+//! selected, including images without pairs. Its `flow` is |E| and its `cost` is that of the
+//! feasible flow of value |E| saturating every pair arc and every image arc
+//! (sum_ij c_ij + sum_i deg(i) c_i). The search stops early when the targets are provably out of
+//! reach: an image without pairs can never carry flow, and since every selected pair feeds one
+//! more image arc, images' flows sum to F + pairs <= 2|E|, so pairs <= 2|E| - F and no F beyond
+//! 2|E| - target_pairs can meet the pair target.
+//!
+//! In practice a search is capped by the image criterion only: with strictly negative costs the
+//! min-cost flow of value |E| is the full graph (every image arc saturated, every pair selected:
+//! dropping a pair loses its cost and one image-arc unit), so the pair target min(ceil(B n), |E|)
+//! is met at the latest at F = |E|; only zero costs (ties) can prevent it. Images without pairs
+//! never carry flow, so A n above the number of images with pairs caps the search at once.
 
 use crate::network::{Selection, SelectionProblem};
+use crate::solver::ParametricSolver;
 use serde::Serialize;
 
 #[derive(Clone, Copy, Debug)]
@@ -45,6 +66,151 @@ pub struct SearchResult {
     pub curve: Vec<CurvePoint>,
 }
 
-pub fn search(_problem: &SelectionProblem, _rule: &FlowRule) -> SearchResult {
-    todo!()
+/// Target counts (images, pairs) of `criteria` for `problem`.
+pub fn targets(problem: &SelectionProblem, criteria: &Criteria) -> (usize, usize) {
+    let n = problem.image_costs.len() as f64;
+    let images = (criteria.min_image_fraction * n).ceil().max(0.0) as usize;
+    let pairs =
+        ((criteria.min_pairs_per_image * n).ceil().max(0.0) as usize).min(problem.pairs.len());
+    (images, pairs)
+}
+
+/// The full graph as a selection (see the module doc).
+pub fn full_selection(problem: &SelectionProblem) -> Selection {
+    let n = problem.image_costs.len();
+    let mut deg = vec![0u64; n];
+    let mut cost = 0.0;
+    for p in &problem.pairs {
+        deg[p.i as usize] += 1;
+        deg[p.j as usize] += 1;
+        cost += p.cost;
+    }
+    for (d, c) in deg.iter().zip(&problem.image_costs) {
+        cost += *d as f64 * c;
+    }
+    Selection {
+        flow: problem.pairs.len() as u64,
+        images: vec![true; n],
+        pairs: vec![true; problem.pairs.len()],
+        cost,
+    }
+}
+
+fn point(solver: &ParametricSolver) -> CurvePoint {
+    CurvePoint {
+        flow: solver.flow(),
+        images_selected: solver.images_selected(),
+        pairs_selected: solver.pairs_selected(),
+    }
+}
+
+/// Runs `rule` on `problem`. The curve starts at F = 0 and ends at the chosen F (for a capped
+/// criteria search: at the last F examined).
+pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
+    let mut solver = ParametricSolver::new(problem);
+    let mut curve = vec![point(&solver)];
+    match *rule {
+        FlowRule::Fixed(f) => {
+            while solver.flow() < f && solver.augment().is_some() {
+                curve.push(point(&solver));
+            }
+            SearchResult {
+                selection: solver.selection(),
+                criteria: Vec::new(),
+                capped: false,
+                curve,
+            }
+        }
+        FlowRule::Criteria(criteria) => {
+            let (target_images, target_pairs) = targets(problem, &criteria);
+            let meets = |p: &CurvePoint| {
+                (
+                    p.images_selected >= target_images,
+                    p.pairs_selected >= target_pairs,
+                )
+            };
+            let reachable_images = {
+                let mut has_pair = vec![false; problem.image_costs.len()];
+                for p in &problem.pairs {
+                    has_pair[p.i as usize] = true;
+                    has_pair[p.j as usize] = true;
+                }
+                has_pair.iter().filter(|&&b| b).count()
+            };
+            // Beyond this F the pair target is out of reach (pairs <= 2|E| - F).
+            let last_useful = 2 * problem.pairs.len() as u64 - target_pairs as u64;
+            let mut ever = (false, false);
+            let mut found = None;
+            let mut prev = (false, false);
+            if target_images > reachable_images {
+                // Out of reach from the start: only the image criterion is to blame.
+                ever = (false, true);
+            } else {
+                loop {
+                    let p = *curve.last().unwrap();
+                    let m = meets(&p);
+                    ever = (ever.0 || m.0, ever.1 || m.1);
+                    if m.0 && m.1 {
+                        found = Some(p);
+                        break;
+                    }
+                    prev = m;
+                    if solver.flow() >= last_useful || solver.augment().is_none() {
+                        break;
+                    }
+                    curve.push(point(&solver));
+                }
+            }
+            let status =
+                |name: &str, target: usize, achieved: usize, binding: bool| CriterionStatus {
+                    name: name.to_string(),
+                    target: target as f64,
+                    achieved: achieved as f64,
+                    met: achieved >= target,
+                    binding,
+                };
+            match found {
+                Some(p) => {
+                    // Binding: not met at F - 1 (none at F = 0, where nothing was needed).
+                    let first = p.flow == 0;
+                    let criteria = vec![
+                        status(
+                            "images",
+                            target_images,
+                            p.images_selected,
+                            !first && !prev.0,
+                        ),
+                        status("pairs", target_pairs, p.pairs_selected, !first && !prev.1),
+                    ];
+                    SearchResult {
+                        selection: solver.selection(),
+                        criteria,
+                        capped: false,
+                        curve,
+                    }
+                }
+                None => {
+                    // Binding: the criteria never met at any F examined; both if each was met
+                    // at some F but never together.
+                    let both = ever.0 && ever.1;
+                    let selection = full_selection(problem);
+                    let criteria = vec![
+                        status(
+                            "images",
+                            target_images,
+                            problem.image_costs.len(),
+                            both || !ever.0,
+                        ),
+                        status("pairs", target_pairs, problem.pairs.len(), both || !ever.1),
+                    ];
+                    SearchResult {
+                        selection,
+                        criteria,
+                        capped: true,
+                        curve,
+                    }
+                }
+            }
+        }
+    }
 }

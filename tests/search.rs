@@ -1,0 +1,193 @@
+//! Flow search: exact smallest F meeting the criteria, capped fallback, fixed F, degenerate input.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::HashSet;
+use vgsel_colmap::network::{PairArc, Selection, SelectionProblem};
+use vgsel_colmap::search::{search, targets, Criteria, FlowRule, SearchResult};
+use vgsel_colmap::solver::{solve, ParametricSolver};
+
+fn random_problem(n: usize, m: usize, seed: u64) -> SelectionProblem {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut seen = HashSet::new();
+    let mut pairs = Vec::with_capacity(m);
+    while pairs.len() < m {
+        let a = rng.gen_range(0..n as u32);
+        let b = rng.gen_range(0..n as u32);
+        if a != b && seen.insert((a.min(b), a.max(b))) {
+            pairs.push(PairArc {
+                i: a.min(b),
+                j: a.max(b),
+                cost: -rng.gen::<f64>(),
+            });
+        }
+    }
+    let image_costs = (0..n).map(|_| -rng.gen::<f64>()).collect();
+    SelectionProblem { image_costs, pairs }
+}
+
+fn counts(s: &Selection) -> (usize, usize) {
+    (
+        s.images.iter().filter(|&&b| b).count(),
+        s.pairs.iter().filter(|&&b| b).count(),
+    )
+}
+
+fn criteria(a: f64, b: f64) -> FlowRule {
+    FlowRule::Criteria(Criteria {
+        min_image_fraction: a,
+        min_pairs_per_image: b,
+    })
+}
+
+fn status<'a>(r: &'a SearchResult, name: &str) -> &'a vgsel_colmap::search::CriterionStatus {
+    r.criteria.iter().find(|c| c.name == name).unwrap()
+}
+
+#[test]
+fn criteria_search_finds_the_smallest_flow() {
+    for (seed, a, b) in [
+        (1u64, 0.8, 2.0),
+        (2, 0.95, 1.0),
+        (3, 0.5, 4.0),
+        (4, 0.9, 3.0),
+    ] {
+        let p = random_problem(80, 700, seed);
+        let rule = criteria(a, b);
+        let FlowRule::Criteria(c) = rule else {
+            unreachable!()
+        };
+        let (ti, tp) = targets(&p, &c);
+        assert_eq!(ti, (a * 80.0f64).ceil() as usize);
+        assert_eq!(tp, ((b * 80.0f64).ceil() as usize).min(700));
+        let r = search(&p, &rule);
+        assert!(!r.capped, "seed {seed}");
+        let f = r.selection.flow;
+        assert!(f >= 1);
+        // meets at F (independent solve), fails at F - 1 and at every smaller F
+        let at = solve(&p, f);
+        assert_eq!(at, r.selection);
+        let (i, e) = counts(&at);
+        assert!(i >= ti && e >= tp);
+        let before = solve(&p, f - 1);
+        let (i0, e0) = counts(&before);
+        assert!(i0 < ti || e0 < tp, "F-1 = {} already meets", f - 1);
+        let mut s = ParametricSolver::new(&p);
+        for g in 1..f {
+            s.augment().unwrap();
+            assert!(
+                s.images_selected() < ti || s.pairs_selected() < tp,
+                "F={g} meets"
+            );
+        }
+        // statuses: met, achieved and binding = not met at F - 1
+        let (si, sp) = (status(&r, "images"), status(&r, "pairs"));
+        assert!(si.met && sp.met);
+        assert_eq!((si.achieved, sp.achieved), (i as f64, e as f64));
+        assert_eq!((si.target, sp.target), (ti as f64, tp as f64));
+        assert_eq!(si.binding, i0 < ti);
+        assert_eq!(sp.binding, e0 < tp);
+        assert!(si.binding || sp.binding);
+        // curve covers F = 0 ..= chosen F and agrees with independent solves
+        assert_eq!(r.curve.len() as u64, f + 1);
+        for (k, pt) in r.curve.iter().enumerate() {
+            assert_eq!(pt.flow, k as u64);
+        }
+        for g in [0, f / 2, f] {
+            let pt = r.curve[g as usize];
+            assert_eq!(
+                (pt.images_selected, pt.pairs_selected),
+                counts(&solve(&p, g))
+            );
+        }
+    }
+}
+
+#[test]
+fn full_graph_at_flow_e_and_capped_search() {
+    // Strictly negative costs: the min-cost flow of value |E| selects every pair, so a pair
+    // target of |E| (B large) is met at some F <= |E| and never caps the search.
+    let p = random_problem(20, 150, 9);
+    let full = solve(&p, 150);
+    assert_eq!(counts(&full), (20, 150));
+    let r = search(&p, &criteria(1.0, 100.0));
+    assert!(!r.capped);
+    assert!(r.selection.flow <= 150);
+    assert_eq!(counts(&r.selection), (20, 150));
+    assert!(status(&r, "pairs").binding);
+
+    // A capped search returns the full graph with the cost of the flow saturating every arc.
+    let mut q = random_problem(20, 60, 4);
+    q.image_costs.push(-0.25); // isolated image 20
+    let r = search(&q, &criteria(1.0, 0.0));
+    assert!(r.capped);
+    assert_eq!(r.selection.images, vec![true; 21]);
+    assert_eq!(r.selection.pairs, vec![true; 60]);
+    assert_eq!(r.selection.flow, 60);
+    let mut deg = [0.0; 21];
+    let mut cost = 0.0;
+    for e in &q.pairs {
+        deg[e.i as usize] += 1.0;
+        deg[e.j as usize] += 1.0;
+        cost += e.cost;
+    }
+    for (d, c) in deg.iter().zip(&q.image_costs) {
+        cost += d * c;
+    }
+    assert!((r.selection.cost - cost).abs() < 1e-9);
+    let si = status(&r, "images");
+    assert!(si.binding && !status(&r, "pairs").binding);
+    assert_eq!((si.target, si.achieved), (21.0, 21.0));
+    // independently: no F up to max flow selects 21 images
+    let mut s = ParametricSolver::new(&q);
+    while s.augment().is_some() {
+        assert!(s.images_selected() <= 20);
+    }
+}
+
+#[test]
+fn fixed_flow() {
+    let p = random_problem(40, 200, 5);
+    let r = search(&p, &FlowRule::Fixed(10));
+    assert!(!r.capped && r.criteria.is_empty());
+    assert_eq!(r.selection.flow, 10);
+    assert_eq!(r.selection, solve(&p, 10));
+    assert_eq!(r.curve.len(), 11);
+    assert_eq!(
+        (r.curve[10].images_selected, r.curve[10].pairs_selected),
+        counts(&r.selection)
+    );
+    let r = search(&p, &FlowRule::Fixed(10_000));
+    assert_eq!(r.selection.flow, 400);
+    assert_eq!(counts(&r.selection).1, 0);
+    let r = search(&p, &FlowRule::Fixed(0));
+    assert_eq!(r.selection.flow, 0);
+    assert_eq!(counts(&r.selection), (0, 0));
+}
+
+#[test]
+fn degenerate_inputs() {
+    let empty = SelectionProblem::default();
+    for rule in [FlowRule::Fixed(5), criteria(0.9, 5.0)] {
+        let r = search(&empty, &rule);
+        assert!(!r.capped);
+        assert_eq!(r.selection.flow, 0);
+        assert!(r.selection.images.is_empty() && r.selection.pairs.is_empty());
+        assert_eq!(r.selection.cost, 0.0);
+    }
+    // images but no pairs
+    let lonely = SelectionProblem {
+        image_costs: vec![-0.5; 4],
+        pairs: vec![],
+    };
+    let r = search(&lonely, &criteria(0.5, 5.0));
+    assert!(r.capped);
+    assert_eq!(r.selection.images, vec![true; 4]);
+    let r = search(&lonely, &criteria(0.0, 5.0));
+    assert!(!r.capped);
+    assert_eq!(r.selection.flow, 0);
+    assert_eq!(r.selection.images, vec![false; 4]);
+    assert!(!status(&r, "images").binding && !status(&r, "pairs").binding);
+    let r = search(&lonely, &FlowRule::Fixed(3));
+    assert_eq!(r.selection.flow, 0);
+}
