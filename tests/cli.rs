@@ -28,19 +28,20 @@ fn ok(args: &[&str]) -> Output {
     out
 }
 
-/// Fails with exit status 1 and exactly one line on stderr; returns that line.
+/// Fails with exit status 1 and one error line on stderr, the last (progress lines may precede
+/// it); returns that line.
 fn fails(args: &[&str]) -> String {
     let out = vgsel(args);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let err = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(err.lines().count(), 1, "not one line: {err}");
-    assert!(err.starts_with("vgsel-colmap: error: "), "{err}");
-    err
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    let errors: Vec<&str> = err.lines().filter(|l| l.contains("error")).collect();
+    assert_eq!(errors.len(), 1, "not one error line: {err}");
+    assert!(
+        errors[0].starts_with("vgsel-colmap: error: ")
+            && err.ends_with(&format!("{}\n", errors[0])),
+        "{err}"
+    );
+    errors[0].to_string()
 }
 
 fn scene() -> (TempDir, PathBuf) {
