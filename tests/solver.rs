@@ -442,3 +442,36 @@ fn timing_paper_graph_1k_100k() {
         r.capped
     );
 }
+
+/// `cargo test --release --test solver timing -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn timing_parse_5m_pairs() {
+    let n = 10_000u32;
+    let mut pairs = Vec::with_capacity(5_000_000);
+    'outer: for k in 1..n {
+        for i in 0..n - k {
+            pairs.push(PairArc {
+                i,
+                j: i + k,
+                cost: -(((i ^ k) % 1000) as f64) / 999.0,
+            });
+            if pairs.len() == 5_000_000 {
+                break 'outer;
+            }
+        }
+    }
+    let p = SelectionProblem {
+        image_costs: vec![-0.5; n as usize],
+        pairs,
+    };
+    let text = vgsel_colmap::graph_file::write(&p);
+    let t0 = Instant::now();
+    let q = vgsel_colmap::graph_file::parse(&text).unwrap();
+    println!(
+        "parse 10K images / 5M pairs ({} MB): {:.3} s",
+        text.len() >> 20,
+        t0.elapsed().as_secs_f64()
+    );
+    assert_eq!(q, p);
+}
