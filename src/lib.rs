@@ -9,9 +9,13 @@
 pub mod align;
 pub mod costs;
 pub mod database;
+pub mod export;
 pub mod graph_file;
 pub mod network;
+pub mod overrides;
+pub mod plots;
 pub mod priors;
+pub mod progress;
 pub mod prune;
 pub mod report;
 pub mod rewrite;

@@ -1,14 +1,16 @@
 //! The `vgsel-colmap` command line.
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::database::Database;
+use vgsel_colmap::overrides::{NameList, Overrides};
+use vgsel_colmap::progress::Progress;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
-use vgsel_colmap::{graph_file, prune, report::Report, rewrite, synth};
+use vgsel_colmap::{export, graph_file, plots, prune, report::Report, rewrite, synth};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -19,8 +21,21 @@ Examples:
   # write a pruned copy and a JSON report, leave db.db untouched:
   vgsel-colmap prune --database_path db.db --output pruned.db --report report.json
 
+  # see what was kept: plots, a pair list for `colmap matches_importer`, a Graphviz graph:
+  vgsel-colmap prune --database_path db.db --dry_run --plots plots --pairs_out pairs.txt
+  vgsel-colmap export --database_path db.db --format dot --output graph.dot
+  dot -Tsvg graph.dot > graph.svg
+
+  # always keep some pairs, never use others (lines `name1 name2`; one image name a line):
+  vgsel-colmap prune --database_path db.db --keep_pairs keep.txt \
+      --forbid_pairs bad_pairs.txt --forbid_images bad_images.txt
+
   # put every original pair back:
   vgsel-colmap restore --database_path db.db
+
+  # shell completions and the man page:
+  vgsel-colmap completions bash > /etc/bash_completion.d/vgsel-colmap
+  vgsel-colmap man > vgsel-colmap.1
 
 Exit status: 0 success, 1 error (the database is left unchanged), 2 bad command line.";
 
@@ -34,6 +49,9 @@ struct Cli {
     /// Print nothing on stderr but errors.
     #[arg(short, long, global = true)]
     quiet: bool,
+    /// Print each stage with its time, and details, as plain lines (instead of progress bars).
+    #[arg(short, long, global = true)]
+    verbose: bool,
 }
 
 #[derive(Subcommand)]
@@ -49,6 +67,26 @@ enum Command {
     /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
     #[command(subcommand)]
     Generate(GenerateCommand),
+    /// Write the view graph with each pair's priors, cost and kept/removed, for Graphviz or networkx.
+    Export(ExportArgs),
+    /// Print a shell completion script.
+    Completions {
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff).
+    Man,
+}
+
+#[derive(Args)]
+struct ExportArgs {
+    #[command(flatten)]
+    database: DatabaseArg,
+    #[arg(long, value_enum)]
+    format: export::Format,
+    /// The file to write.
+    #[arg(long, value_name = "FILE")]
+    output: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -168,9 +206,47 @@ struct PruneArgs {
     /// Which priors make the costs.
     #[arg(long, value_enum, default_value = "general")]
     preset: Preset,
-    /// Write a JSON report here.
+    /// Write a JSON report here (schema: docs/report.md).
     #[arg(long, value_name = "FILE")]
     report: Option<PathBuf>,
+    /// Write selection_curve.svg and match_matrix.svg into this directory.
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
+    /// Write the kept pairs as `name1 name2` lines (colmap matches_importer --match_type pairs).
+    #[arg(long = "pairs_out", visible_alias = "pairs-out", value_name = "FILE")]
+    pairs_out: Option<PathBuf>,
+    /// Always keep these pairs (lines `name1 name2`).
+    #[arg(long = "keep_pairs", visible_alias = "keep-pairs", value_name = "FILE")]
+    keep_pairs: Option<PathBuf>,
+    /// Never select these pairs (lines `name1 name2`).
+    #[arg(
+        long = "forbid_pairs",
+        visible_alias = "forbid-pairs",
+        value_name = "FILE"
+    )]
+    forbid_pairs: Option<PathBuf>,
+    /// Never select these images nor any of their pairs (one name a line).
+    #[arg(
+        long = "forbid_images",
+        visible_alias = "forbid-images",
+        value_name = "FILE"
+    )]
+    forbid_images: Option<PathBuf>,
+}
+
+impl PruneArgs {
+    fn overrides(&self) -> Result<Overrides> {
+        let read = |path: &Option<PathBuf>, pairs| {
+            path.as_deref()
+                .map(|p| NameList::read(p, pairs))
+                .transpose()
+        };
+        Ok(Overrides {
+            keep_pairs: read(&self.keep_pairs, true)?,
+            forbid_pairs: read(&self.forbid_pairs, true)?,
+            forbid_images: read(&self.forbid_images, false)?,
+        })
+    }
 }
 
 #[derive(Args)]
@@ -199,13 +275,28 @@ fn non_negative(s: &str) -> Result<f64, String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let quiet = cli.quiet;
+    let progress = Progress::new(quiet, cli.verbose);
     let result = match cli.command {
-        Command::Prune(args) => run_prune(&args, quiet),
+        Command::Prune(args) => run_prune(&args, quiet, &progress),
         Command::Restore(args) => run_restore(&args, quiet),
         Command::Inspect(args) => run_inspect(&args),
         Command::Solve(args) => run_solve(&args),
         Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
+        Command::Export(args) => run_export(&args, quiet, &progress),
+        Command::Completions { shell } => {
+            clap_complete::generate(
+                shell,
+                &mut Cli::command(),
+                "vgsel-colmap",
+                &mut std::io::stdout(),
+            );
+            Ok(())
+        }
+        Command::Man => clap_mangen::Man::new(Cli::command())
+            .render(&mut std::io::stdout())
+            .context("cannot write the man page"),
     };
+    progress.finish();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -218,7 +309,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
+fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     let input = &args.database.database_path;
     if let Some(out) = &args.output {
         if out.exists() && !args.overwrite {
@@ -247,12 +338,18 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
             Preset::General => CostModel::general(),
         },
     };
-    let stage = |s: &str| {
-        if !quiet {
-            eprintln!("vgsel-colmap: {s}");
-        }
-    };
-    let mut plan = prune::plan(&db, &options, &stage)?;
+    let stage = |s: &str| progress.stage(s);
+    let overrides = args.overrides()?;
+    let mut plan = prune::plan_with(&db, &options, &overrides, &stage)?;
+    progress.detail(&format!(
+        "view graph: {} images, {} pairs; network: {} images, {} pairs; flow F = {}",
+        plan.graph.num_vertices(),
+        plan.graph.edges.len(),
+        plan.network.problem.image_costs.len(),
+        plan.network.problem.pairs.len(),
+        plan.search.selection.flow
+    ));
+    let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     let parameters = serde_json::json!({
         "preset": "general",
         "min_num_matches": args.min_num_matches,
@@ -260,6 +357,9 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
         "min_image_fraction": args.flow.min_image_fraction,
         "min_pairs_per_image": args.flow.min_pairs_per_image,
         "cost_model": options.model,
+        "keep_pairs": path_text(&args.keep_pairs),
+        "forbid_pairs": path_text(&args.forbid_pairs),
+        "forbid_images": path_text(&args.forbid_images),
     });
     let written_to = if args.dry_run {
         None
@@ -289,7 +389,17 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
         plan.timings.total += plan.timings.write;
         Some(target.display().to_string())
     };
-    let report = Report::new(&plan, input.display().to_string(), written_to, parameters);
+    let mut report = Report::new(&plan, input.display().to_string(), written_to, parameters);
+    if let Some(path) = &args.pairs_out {
+        std::fs::write(path, export::pairs_list(&plan))
+            .with_context(|| format!("cannot write --pairs_out {}", path.display()))?;
+        report.outputs.pairs_out = Some(path.display().to_string());
+    }
+    if let Some(dir) = &args.plots {
+        let files = plots::write(&plan, dir, progress)?;
+        report.outputs.plots = files.iter().map(|f| f.display().to_string()).collect();
+    }
+    progress.finish();
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report)?;
         std::fs::write(path, json + "\n")
@@ -391,6 +501,25 @@ fn run_inspect(args: &InspectArgs) -> Result<()> {
             "no"
         }
     );
+    Ok(())
+}
+
+fn run_export(args: &ExportArgs, quiet: bool, progress: &Progress) -> Result<()> {
+    let db = Database::open_read_only(&args.database.database_path)?;
+    progress.stage("computing priors and costs");
+    let (text, counts) = export::export(&db, args.format)?;
+    std::fs::write(&args.output, text)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    progress.finish();
+    if !quiet {
+        eprintln!(
+            "vgsel-colmap: wrote {} images and {} pairs ({} kept) to {}",
+            counts.images,
+            counts.pairs,
+            counts.pairs_kept,
+            args.output.display()
+        );
+    }
     Ok(())
 }
 
