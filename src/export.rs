@@ -49,10 +49,13 @@ impl Value {
     }
 }
 
+/// Named attribute values of a node or an edge, in output order.
+type Attrs = Vec<(String, Value)>;
+
 /// Nodes (id = image name) and edges (names of both ends) with their attributes, in order.
 struct Graph {
-    nodes: Vec<(String, Vec<(String, Value)>)>,
-    edges: Vec<(String, String, Vec<(String, Value)>)>,
+    nodes: Vec<(String, Attrs)>,
+    edges: Vec<(String, String, Attrs)>,
 }
 
 /// What an export wrote, for the command's summary.

@@ -57,6 +57,11 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Keep only the selected pairs valid in two_view_geometries (reversible).
+    #[command(after_help = "Examples:
+  vgsel-colmap prune --database_path db.db --report report.json --plots plots
+  vgsel-colmap prune --database_path db.db --dry_run -v --min_pairs_per_image 10
+  vgsel-colmap prune --database_path db.db --output pruned.db --pairs_out pairs.txt \\
+      --keep_pairs keep.txt --forbid_images bad_images.txt")]
     Prune(PruneArgs),
     /// Put back every pair a prune invalidated, byte for byte, and drop vgsel-colmap's tables.
     Restore(DatabaseArg),
@@ -68,6 +73,11 @@ enum Command {
     #[command(subcommand)]
     Generate(GenerateCommand),
     /// Write the view graph with each pair's priors, cost and kept/removed, for Graphviz or networkx.
+    #[command(after_help = "Examples:
+  vgsel-colmap export --database_path db.db --format dot --output graph.dot
+  dot -Tsvg graph.dot > graph.svg
+  vgsel-colmap export --database_path db.db --format graphml --output graph.graphml
+  python3 -c \"import networkx; print(networkx.read_graphml('graph.graphml'))\"")]
     Export(ExportArgs),
     /// Print a shell completion script.
     Completions {
@@ -284,17 +294,17 @@ fn main() -> ExitCode {
         Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
         Command::Export(args) => run_export(&args, quiet, &progress),
         Command::Completions { shell } => {
-            clap_complete::generate(
-                shell,
-                &mut Cli::command(),
-                "vgsel-colmap",
-                &mut std::io::stdout(),
-            );
-            Ok(())
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "vgsel-colmap", &mut script);
+            print_bytes(&script, "the completion script")
         }
-        Command::Man => clap_mangen::Man::new(Cli::command())
-            .render(&mut std::io::stdout())
-            .context("cannot write the man page"),
+        Command::Man => {
+            let mut page = Vec::new();
+            clap_mangen::Man::new(Cli::command())
+                .render(&mut page)
+                .map_err(anyhow::Error::from)
+                .and_then(|()| print_bytes(&page, "the man page"))
+        }
     };
     progress.finish();
     match result {
@@ -409,6 +419,14 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         eprintln!("{}", report.summary());
     }
     Ok(())
+}
+
+/// Writes generated text to stdout; a closed pipe (`| head`) is an error line, not a panic.
+fn print_bytes(bytes: &[u8], what: &str) -> Result<()> {
+    use std::io::Write;
+    std::io::stdout()
+        .write_all(bytes)
+        .with_context(|| format!("cannot write {what}"))
 }
 
 /// Copies `input` to a temporary file beside `out`, prunes the copy, then renames it to `out`:

@@ -221,8 +221,8 @@ impl Network {
         let mut index = vec![u32::MAX; graph.num_vertices()];
         let mut vertex_of = Vec::new();
         let mut image_costs = Vec::new();
-        for v in 0..graph.num_vertices() {
-            if !resolved.forbidden_vertices[v] {
+        for (v, &forbidden) in resolved.forbidden_vertices.iter().enumerate() {
+            if !forbidden {
                 index[v] = vertex_of.len() as u32;
                 vertex_of.push(v as u32);
                 image_costs.push(costs.image_costs[v]);
