@@ -11,6 +11,9 @@ use std::path::{Path, PathBuf};
 /// Images per axis above which the match matrix bins images, to keep the SVG small.
 const MAX_CELLS: usize = 600;
 
+/// (F, fraction of the network's images selected, fraction of its pairs selected).
+pub type Point = (u64, [f64; 2]);
+
 /// Writes `selection_curve.svg` and `match_matrix.svg` into `dir` (created if missing) and
 /// returns their paths.
 pub fn write(plan: &Plan, dir: &Path, progress: &Progress) -> Result<Vec<PathBuf>> {
@@ -24,10 +27,9 @@ pub fn write(plan: &Plan, dir: &Path, progress: &Progress) -> Result<Vec<PathBuf
     Ok(vec![curve_path, matrix_path])
 }
 
-/// (F, fraction of the network's images selected, fraction of its pairs selected) for F = 1, 2,
-/// ... up to four times the chosen F — past the choice, to show what more flow would buy — and
+/// The curve for F = 1, 2, ... up to four times the chosen F — past the choice, to show what more flow would buy — and
 /// no further than the flow selecting every pair.
-pub fn curve_points(plan: &Plan, progress: &Progress) -> Vec<(u64, f64, f64)> {
+pub fn curve_points(plan: &Plan, progress: &Progress) -> Vec<Point> {
     let problem = &plan.network.problem;
     let images = problem.image_costs.len().max(1) as f64;
     let pairs = problem.pairs.len().max(1) as f64;
@@ -40,8 +42,10 @@ pub fn curve_points(plan: &Plan, progress: &Progress) -> Vec<(u64, f64, f64)> {
         bar.set_position(solver.flow());
         points.push((
             solver.flow(),
-            solver.images_selected() as f64 / images,
-            solver.pairs_selected() as f64 / pairs,
+            [
+                solver.images_selected() as f64 / images,
+                solver.pairs_selected() as f64 / pairs,
+            ],
         ));
         if solver.pairs_selected() == problem.pairs.len() && solver.flow() >= chosen {
             break;
@@ -54,7 +58,7 @@ fn plot_error<E: std::fmt::Debug>(path: &Path) -> impl FnOnce(E) -> anyhow::Erro
     move |e| anyhow!("cannot draw {}: {e:?}", path.display())
 }
 
-fn selection_curve(points: &[(u64, f64, f64)], plan: &Plan, path: &Path) -> Result<()> {
+fn selection_curve(points: &[Point], plan: &Plan, path: &Path) -> Result<()> {
     let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
     root.fill(&WHITE).map_err(plot_error(path))?;
     let chosen = plan.search.selection.flow.max(1) as f64;
@@ -74,18 +78,14 @@ fn selection_curve(points: &[(u64, f64, f64)], plan: &Plan, path: &Path) -> Resu
         .y_desc("fraction selected")
         .draw()
         .map_err(plot_error(path))?;
-    let images = points.iter().map(|p| (p.0 as f64, p.1));
-    chart
-        .draw_series(LineSeries::new(images, BLUE.stroke_width(2)))
-        .map_err(plot_error(path))?
-        .label("images")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.stroke_width(2)));
-    let pairs = points.iter().map(|p| (p.0 as f64, p.2));
-    chart
-        .draw_series(LineSeries::new(pairs, RED.stroke_width(2)))
-        .map_err(plot_error(path))?
-        .label("pairs")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+    for (k, (label, color)) in [("images", BLUE), ("pairs", RED)].into_iter().enumerate() {
+        let line = points.iter().map(|p| (p.0 as f64, p.1[k]));
+        chart
+            .draw_series(LineSeries::new(line, color.stroke_width(2)))
+            .map_err(plot_error(path))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+    }
     let marker = if plan.search.capped {
         format!("F = {} (capped: full graph)", plan.search.selection.flow)
     } else {

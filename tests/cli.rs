@@ -3,30 +3,10 @@
 
 mod common;
 
-use common::{dump, schema, table_names, user_version};
+use common::{dump, ok, scene, schema, table_names, user_version, vgsel};
 use rusqlite::types::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use tempfile::TempDir;
+use std::path::Path;
 use vgsel_colmap::database::image_ids;
-use vgsel_colmap::synth::{generate, SceneSpec};
-
-fn vgsel(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
-        .args(args)
-        .output()
-        .expect("running vgsel-colmap")
-}
-
-fn ok(args: &[&str]) -> Output {
-    let out = vgsel(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
 
 /// Fails with exit status 1 and one error line on stderr, the last (progress lines may precede
 /// it); returns that line.
@@ -42,22 +22,6 @@ fn fails(args: &[&str]) -> String {
         "{err}"
     );
     errors[0].to_string()
-}
-
-fn scene() -> (TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    let db = dir.path().join("scene.db");
-    generate(
-        &SceneSpec {
-            num_images: 16,
-            num_points: 3000,
-            seed: 3,
-            ..Default::default()
-        },
-        &db,
-    )
-    .unwrap();
-    (dir, db)
 }
 
 fn s(p: &Path) -> &str {

@@ -2,44 +2,12 @@
 //! pair list, the graph exports (checked by Graphviz and networkx when installed), the overrides,
 //! progress output, completions and the man page.
 
+mod common;
+
+use common::{ok, scene, vgsel};
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use tempfile::TempDir;
-use vgsel_colmap::synth::{generate, SceneSpec};
-
-fn vgsel(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
-        .args(args)
-        .output()
-        .expect("running vgsel-colmap")
-}
-
-fn ok(args: &[&str]) -> Output {
-    let out = vgsel(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn scene() -> (TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    let db = dir.path().join("scene.db");
-    generate(
-        &SceneSpec {
-            num_images: 16,
-            num_points: 3000,
-            seed: 3,
-            ..Default::default()
-        },
-        &db,
-    )
-    .unwrap();
-    (dir, db)
-}
+use std::path::Path;
+use std::process::Command;
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
