@@ -10,7 +10,11 @@ use vgsel_colmap::database::Database;
 use vgsel_colmap::overrides::{NameList, Overrides};
 use vgsel_colmap::progress::Progress;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
-use vgsel_colmap::{export, graph_file, plots, prune, report::Report, rewrite, synth};
+use vgsel_colmap::{
+    export, graph_file, plots, prune,
+    report::{Outputs, Report},
+    rewrite, synth,
+};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -371,6 +375,17 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         "forbid_pairs": path_text(&args.forbid_pairs),
         "forbid_images": path_text(&args.forbid_images),
     });
+    // The extra files first: if one cannot be written, the database is still untouched.
+    let mut outputs = Outputs::default();
+    if let Some(path) = &args.pairs_out {
+        std::fs::write(path, export::pairs_list(&plan))
+            .with_context(|| format!("cannot write --pairs_out {}", path.display()))?;
+        outputs.pairs_out = Some(path.display().to_string());
+    }
+    if let Some(dir) = &args.plots {
+        let files = plots::write(&plan, dir, progress)?;
+        outputs.plots = files.iter().map(|f| f.display().to_string()).collect();
+    }
     let written_to = if args.dry_run {
         None
     } else {
@@ -400,15 +415,7 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         Some(target.display().to_string())
     };
     let mut report = Report::new(&plan, input.display().to_string(), written_to, parameters);
-    if let Some(path) = &args.pairs_out {
-        std::fs::write(path, export::pairs_list(&plan))
-            .with_context(|| format!("cannot write --pairs_out {}", path.display()))?;
-        report.outputs.pairs_out = Some(path.display().to_string());
-    }
-    if let Some(dir) = &args.plots {
-        let files = plots::write(&plan, dir, progress)?;
-        report.outputs.plots = files.iter().map(|f| f.display().to_string()).collect();
-    }
+    report.outputs = outputs;
     progress.finish();
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report)?;
