@@ -9,7 +9,9 @@
 pub mod align;
 pub mod costs;
 pub mod database;
+pub mod eval;
 pub mod graph_file;
+pub mod model;
 pub mod network;
 pub mod priors;
 pub mod prune;

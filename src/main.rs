@@ -8,7 +8,7 @@ use std::time::Instant;
 use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::database::Database;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
-use vgsel_colmap::{graph_file, prune, report::Report, rewrite, synth};
+use vgsel_colmap::{eval, graph_file, prune, report::Report, rewrite, synth};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -46,9 +46,25 @@ enum Command {
     Inspect(InspectArgs),
     /// Run the selection solver on a plain-text graph (benchmarks, solver-only users).
     Solve(SolveArgs),
+    /// Score a reconstruction against ground-truth poses; prints JSON.
+    Eval(EvalArgs),
     /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
     #[command(subcommand)]
     Generate(GenerateCommand),
+}
+
+#[derive(Args)]
+struct EvalArgs {
+    /// A COLMAP model folder (binary or text), or a folder of sub-models (mapper's output_path).
+    #[arg(long, value_name = "DIR")]
+    model: PathBuf,
+    /// The ground-truth model (COLMAP text or binary); images are matched by name.
+    #[arg(
+        long = "ground_truth",
+        visible_alias = "ground-truth",
+        value_name = "DIR"
+    )]
+    ground_truth: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -204,6 +220,7 @@ fn main() -> ExitCode {
         Command::Restore(args) => run_restore(&args, quiet),
         Command::Inspect(args) => run_inspect(&args),
         Command::Solve(args) => run_solve(&args),
+        Command::Eval(args) => run_eval(&args),
         Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
     };
     match result {
@@ -428,5 +445,11 @@ fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         synth::write_gt_model(&gt, dir)?;
     }
+    Ok(())
+}
+
+fn run_eval(args: &EvalArgs) -> Result<()> {
+    let scores = eval::score(&args.model, &args.ground_truth)?;
+    println!("{}", serde_json::to_string_pretty(&scores)?);
     Ok(())
 }
