@@ -3,7 +3,7 @@
 # COLMAP 3.8 (real mapper runs in tests) and sqlite3 (inspection in scripts).
 # Does nothing for packages already installed; needs root or sudo otherwise.
 set -euo pipefail
-packages=(colmap sqlite3)
+packages=(colmap sqlite3 bc)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
