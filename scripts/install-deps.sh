@@ -4,7 +4,7 @@
 # export test renders the DOT file with `dot`).
 # Does nothing for packages already installed; needs root or sudo otherwise.
 set -euo pipefail
-packages=(colmap sqlite3 graphviz)
+packages=(colmap sqlite3 bc graphviz)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -3,15 +3,15 @@
 //! Why: a reconstruction is only defined up to a similarity, so its poses must be aligned onto
 //! the ground truth before errors mean anything. [`umeyama`] is the closed-form least-squares
 //! fit; [`umeyama_ransac`] makes it robust to a few badly placed cameras, so one wrong image
-//! does not hide how good the rest is. [`read_text_model_images`] reads COLMAP's text models.
+//! does not hide how good the rest is.
 
-use anyhow::{bail, ensure, Context, Result};
+use crate::model::ModelImage;
+use anyhow::{bail, ensure, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rand::seq::index::sample;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
-use std::path::Path;
 
 /// x -> scale * rotation * x + translation.
 #[derive(Clone, Debug, PartialEq)]
@@ -164,68 +164,6 @@ pub fn rotation_error_deg(
     (2.0 * rel.imag().norm().atan2(rel.w.abs())).to_degrees()
 }
 
-/// One image of a COLMAP model (x_cam = rotation * X + translation).
-#[derive(Clone, Debug)]
-pub struct ModelImage {
-    pub image_id: u32,
-    pub camera_id: u32,
-    pub name: String,
-    pub rotation: UnitQuaternion<f64>,
-    pub translation: Vector3<f64>,
-}
-
-impl ModelImage {
-    /// Camera centre -R^T t.
-    pub fn centre(&self) -> Vector3<f64> {
-        -(self.rotation.inverse() * self.translation)
-    }
-}
-
-/// Images of a COLMAP text model (`DIR/images.txt`): each image is a pose line
-/// `IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME` followed by a (possibly empty) 2D-point line.
-pub fn read_text_model_images(dir: &Path) -> Result<Vec<ModelImage>> {
-    let path = dir.join("images.txt");
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let mut out = Vec::new();
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.starts_with('#'));
-    while let Some((no, line)) = lines.next() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let tok: Vec<&str> = line.split_whitespace().collect();
-        ensure!(
-            tok.len() >= 10,
-            "{}:{}: expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME",
-            path.display(),
-            no + 1
-        );
-        let num = |i: usize| -> Result<f64> {
-            tok[i]
-                .parse::<f64>()
-                .with_context(|| format!("{}:{}: bad number {:?}", path.display(), no + 1, tok[i]))
-        };
-        let q = nalgebra::Quaternion::new(num(1)?, num(2)?, num(3)?, num(4)?);
-        out.push(ModelImage {
-            image_id: tok[0]
-                .parse()
-                .with_context(|| format!("{}:{}: bad IMAGE_ID", path.display(), no + 1))?,
-            camera_id: tok[8]
-                .parse()
-                .with_context(|| format!("{}:{}: bad CAMERA_ID", path.display(), no + 1))?,
-            name: tok[9..].join(" "),
-            rotation: UnitQuaternion::from_quaternion(q),
-            translation: Vector3::new(num(5)?, num(6)?, num(7)?),
-        });
-        // The 2D-point line (may be empty).
-        lines.next();
-    }
-    Ok(out)
-}
-
 /// Pose errors of an estimated model against the truth, matched by image name.
 #[derive(Clone, Debug)]
 pub struct Evaluation {
@@ -366,24 +304,5 @@ mod tests {
     fn extent_is_largest_distance() {
         let pts = [Vector3::zeros(), Vector3::new(3.0, 4.0, 0.0), Vector3::x()];
         assert!((scene_extent(&pts) - 5.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn reads_text_model_with_empty_point_lines() {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(
-            dir.path().join("images.txt"),
-            "# comment\n# Number of images: 2\n\
-             1 1 0 0 0 1 2 3 1 a.jpg\n\
-             10.5 20.5 -1\n\
-             2 0 1 0 0 0 0 1 1 b c.jpg\n\n",
-        )
-        .unwrap();
-        let images = read_text_model_images(dir.path()).unwrap();
-        assert_eq!(images.len(), 2);
-        assert_eq!(images[0].name, "a.jpg");
-        assert_eq!(images[1].name, "b c.jpg");
-        assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
-        assert!((images[1].centre() - Vector3::new(0.0, 0.0, 1.0)).norm() < 1e-12);
     }
 }

@@ -9,8 +9,10 @@
 pub mod align;
 pub mod costs;
 pub mod database;
+pub mod eval;
 pub mod export;
 pub mod graph_file;
+pub mod model;
 pub mod network;
 pub mod overrides;
 pub mod plots;

@@ -11,7 +11,7 @@ use vgsel_colmap::overrides::{NameList, Overrides};
 use vgsel_colmap::progress::Progress;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
 use vgsel_colmap::{
-    export, graph_file, plots, prune,
+    eval, export, graph_file, plots, prune,
     report::{Outputs, Report},
     rewrite, synth,
 };
@@ -73,6 +73,8 @@ enum Command {
     Inspect(InspectArgs),
     /// Run the selection solver on a plain-text graph (benchmarks, solver-only users).
     Solve(SolveArgs),
+    /// Score a reconstruction against ground-truth poses; prints JSON.
+    Eval(EvalArgs),
     /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
     #[command(subcommand)]
     Generate(GenerateCommand),
@@ -101,6 +103,20 @@ struct ExportArgs {
     /// The file to write.
     #[arg(long, value_name = "FILE")]
     output: PathBuf,
+}
+
+#[derive(Args)]
+struct EvalArgs {
+    /// A COLMAP model folder (binary or text), or a folder of sub-models (mapper's output_path).
+    #[arg(long, value_name = "DIR")]
+    model: PathBuf,
+    /// The ground-truth model (COLMAP text or binary); images are matched by name.
+    #[arg(
+        long = "ground_truth",
+        visible_alias = "ground-truth",
+        value_name = "DIR"
+    )]
+    ground_truth: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -295,6 +311,7 @@ fn main() -> ExitCode {
         Command::Restore(args) => run_restore(&args, quiet),
         Command::Inspect(args) => run_inspect(&args),
         Command::Solve(args) => run_solve(&args),
+        Command::Eval(args) => run_eval(&args),
         Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
         Command::Export(args) => run_export(&args, quiet, &progress),
         Command::Completions { shell } => {
@@ -582,5 +599,11 @@ fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         synth::write_gt_model(&gt, dir)?;
     }
+    Ok(())
+}
+
+fn run_eval(args: &EvalArgs) -> Result<()> {
+    let scores = eval::score(&args.model, &args.ground_truth)?;
+    println!("{}", serde_json::to_string_pretty(&scores)?);
     Ok(())
 }

@@ -26,7 +26,7 @@
 //! point. Today every point has its own appearance; a duplicate-structure scene only has to give
 //! two copies of an object the same appearance ids, and [`GtPair::true_pair`] labels the result.
 
-use crate::align::ModelImage;
+use crate::model::ModelImage;
 use anyhow::{bail, ensure, Context, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rand::seq::SliceRandom;

@@ -241,38 +241,18 @@ fn bad_input_fails_with_one_line_and_changes_nothing() {
     assert_eq!(std::fs::read(&db).unwrap(), bytes);
 
     // Command-line mistakes are usage errors (status 2).
+    let usage = |extra: &[&str]| {
+        let mut args = vec!["prune", "--database_path", s(&db)];
+        args.extend_from_slice(extra);
+        vgsel(&args).status.code()
+    };
+    assert_eq!(usage(&["--flow", "0"]), Some(2));
+    assert_eq!(usage(&["--min_image_fraction", "1.5"]), Some(2));
     assert_eq!(
-        vgsel(&["prune", "--database_path", s(&db), "--flow", "0"])
-            .status
-            .code(),
+        usage(&["--flow", "3", "--min_image_fraction", "0.5"]),
         Some(2)
     );
-    assert_eq!(
-        vgsel(&[
-            "prune",
-            "--database_path",
-            s(&db),
-            "--min_image_fraction",
-            "1.5"
-        ])
-        .status
-        .code(),
-        Some(2)
-    );
-    assert_eq!(
-        vgsel(&[
-            "prune",
-            "--database_path",
-            s(&db),
-            "--flow",
-            "3",
-            "--min_image_fraction",
-            "0.5"
-        ])
-        .status
-        .code(),
-        Some(2)
-    );
+    assert_eq!(std::fs::read(&db).unwrap(), bytes);
 }
 
 #[test]
@@ -284,4 +264,38 @@ fn dashed_option_names_work_too() {
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(v["images_total"], 16);
     assert_eq!(v["pruned_by_vgsel_colmap"], false);
+}
+
+#[test]
+fn solve_on_the_triangle_fixture() {
+    let graph = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/triangle.graph");
+    let run = |args: &[&str]| -> serde_json::Value {
+        let mut all = vec!["solve", "--graph", graph];
+        all.extend_from_slice(args);
+        serde_json::from_slice(&ok(&all).stdout).unwrap()
+    };
+    // F = 1: one path; the chain 0-1-2 (-2.7) beats 0-2 or 0-1 (-1.7 each).
+    let one = run(&["--flow", "1"]);
+    assert!((one["cost"].as_f64().unwrap() + 2.7).abs() < 1e-9, "{one}");
+    assert_eq!(
+        (
+            one["images_selected"].as_u64(),
+            one["pairs_selected"].as_u64()
+        ),
+        (Some(3), Some(2))
+    );
+    // F = 2: image arcs have capacity deg = 2, so the chain plus 0-2 (-1.7) fits: -4.4.
+    let two = run(&["--flow", "2"]);
+    assert!((two["cost"].as_f64().unwrap() + 4.4).abs() < 1e-9, "{two}");
+    assert_eq!(two["pairs_selected"], 3);
+    assert!(two["solve_seconds"].as_f64().unwrap() >= 0.0);
+    // All images and min(1 x 3, 3) pairs: the smallest such F is 2.
+    let search = run(&["--min_image_fraction", "1", "--min_pairs_per_image", "1"]);
+    assert_eq!(search["flow"], 2);
+    assert_eq!(search["capped"], false);
+
+    let bad = tempfile::NamedTempFile::new().unwrap();
+    std::fs::write(bad.path(), "2 1\n-0.5\n-0.5\n1 0 -0.5\n").unwrap();
+    let message = fails(&["solve", "--graph", s(bad.path())]);
+    assert!(message.contains("line 4"), "{message}");
 }

@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use vgsel_colmap::align::{evaluate, read_text_model_images};
+use vgsel_colmap::align::evaluate;
+use vgsel_colmap::model::read_images;
 use vgsel_colmap::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
 
 fn colmap() -> Command {
@@ -106,7 +107,7 @@ fn map_and_check(dir: &Path, db: &Path, gt: &GroundTruth) {
         .arg(&text)
         .args(["--output_type", "TXT"]);
     run(cmd);
-    let estimated = read_text_model_images(&text).unwrap();
+    let estimated = read_images(&text).unwrap();
     let eval = evaluate(&estimated, &gt.model_images()).unwrap();
     eprintln!(
         "registered {}/{}; max position error {:.4} ({:.3}% of extent {:.2}); max rotation error {:.3} deg",
@@ -171,7 +172,7 @@ fn colmap_reads_the_ground_truth_model() {
             .args(["--output_type", kind]);
         run(cmd);
     }
-    let images = read_text_model_images(&back).unwrap();
+    let images = read_images(&back).unwrap();
     let eval = evaluate(&images, &gt.model_images()).unwrap();
     assert!(eval.missing.is_empty());
     assert!(eval.max_position_error() < 1e-6 * eval.extent);

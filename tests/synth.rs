@@ -4,7 +4,8 @@ use nalgebra::{Matrix3, Vector3};
 use rusqlite::{Connection, OptionalExtension};
 use std::collections::HashSet;
 use std::path::Path;
-use vgsel_colmap::align::{evaluate, read_text_model_images};
+use vgsel_colmap::align::evaluate;
+use vgsel_colmap::model::read_images;
 use vgsel_colmap::synth::{generate, pair_geometry, write_gt_model, GroundTruth, SceneSpec};
 
 const BASE: u64 = 2_147_483_647;
@@ -367,7 +368,7 @@ fn ground_truth_model_round_trips() {
     for f in ["cameras.txt", "images.txt", "points3D.txt"] {
         assert!(model.join(f).is_file());
     }
-    let images = read_text_model_images(&model).unwrap();
+    let images = read_images(&model).unwrap();
     assert_eq!(images.len(), gt.images.len());
     for (m, g) in images.iter().zip(&gt.images) {
         assert_eq!(m.name, g.name);

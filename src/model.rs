@@ -1,0 +1,238 @@
+//! Reading COLMAP sparse models (the images and their poses), text or binary, one model or a
+//! folder of sub-models as `colmap mapper` writes them (`sparse/0`, `sparse/1`, ...).
+
+use anyhow::{ensure, Context, Result};
+use nalgebra::{UnitQuaternion, Vector3};
+use std::path::{Path, PathBuf};
+
+/// One image of a COLMAP model (x_cam = rotation * X + translation).
+#[derive(Clone, Debug)]
+pub struct ModelImage {
+    pub image_id: u32,
+    pub camera_id: u32,
+    pub name: String,
+    pub rotation: UnitQuaternion<f64>,
+    pub translation: Vector3<f64>,
+}
+
+impl ModelImage {
+    /// Camera centre -R^T t.
+    pub fn centre(&self) -> Vector3<f64> {
+        -(self.rotation.inverse() * self.translation)
+    }
+}
+
+/// Images of a COLMAP text model (`DIR/images.txt`): each image is a pose line
+/// `IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME` followed by a (possibly empty) 2D-point line.
+fn read_text_images(dir: &Path) -> Result<Vec<ModelImage>> {
+    let path = dir.join("images.txt");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let mut out = Vec::new();
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.starts_with('#'));
+    while let Some((no, line)) = lines.next() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let tok: Vec<&str> = line.split_whitespace().collect();
+        ensure!(
+            tok.len() >= 10,
+            "{}:{}: expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME",
+            path.display(),
+            no + 1
+        );
+        let num = |i: usize| -> Result<f64> {
+            tok[i]
+                .parse::<f64>()
+                .with_context(|| format!("{}:{}: bad number {:?}", path.display(), no + 1, tok[i]))
+        };
+        let q = nalgebra::Quaternion::new(num(1)?, num(2)?, num(3)?, num(4)?);
+        out.push(ModelImage {
+            image_id: tok[0]
+                .parse()
+                .with_context(|| format!("{}:{}: bad IMAGE_ID", path.display(), no + 1))?,
+            camera_id: tok[8]
+                .parse()
+                .with_context(|| format!("{}:{}: bad CAMERA_ID", path.display(), no + 1))?,
+            name: tok[9..].join(" "),
+            rotation: UnitQuaternion::from_quaternion(q),
+            translation: Vector3::new(num(5)?, num(6)?, num(7)?),
+        });
+        // The 2D-point line (may be empty).
+        lines.next();
+    }
+    Ok(out)
+}
+
+/// Images of one model folder: `images.bin` if present, else `images.txt`.
+pub fn read_images(dir: &Path) -> Result<Vec<ModelImage>> {
+    if dir.join("images.bin").is_file() {
+        read_binary_images(dir)
+    } else {
+        read_text_images(dir)
+    }
+}
+
+/// The model folders under `dir`: `dir` itself when it holds a model, else its sub-folders that
+/// do, in name order (COLMAP numbers them 0, 1, ...; the first is the largest).
+pub fn model_dirs(dir: &Path) -> Result<Vec<PathBuf>> {
+    let is_model = |d: &Path| d.join("images.bin").is_file() || d.join("images.txt").is_file();
+    if is_model(dir) {
+        return Ok(vec![dir.to_path_buf()]);
+    }
+    let entries = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read model folder {}", dir.display()))?;
+    let mut dirs: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| is_model(p))
+        .collect();
+    dirs.sort_by_key(|p| {
+        let name = p
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
+        (name.parse::<u64>().unwrap_or(u64::MAX), name)
+    });
+    Ok(dirs)
+}
+
+/// `images.bin`: u64 count, then per image u32 id, 4 f64 qvec, 3 f64 tvec, u32 camera id, a
+/// NUL-terminated name, u64 point count and that many (f64 x, f64 y, i64 point3D id).
+fn read_binary_images(dir: &Path) -> Result<Vec<ModelImage>> {
+    let path = dir.join("images.bin");
+    let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+    let mut r = Reader {
+        bytes: &bytes,
+        at: 0,
+        path: &path,
+    };
+    let count = r.u64()?;
+    let mut out = Vec::new();
+    for _ in 0..count {
+        let image_id = r.u32()?;
+        let q = [r.f64()?, r.f64()?, r.f64()?, r.f64()?];
+        let t = [r.f64()?, r.f64()?, r.f64()?];
+        let camera_id = r.u32()?;
+        let name = r.name()?;
+        let points = r.u64()?;
+        r.skip(points.checked_mul(24).context("corrupt point count")? as usize)?;
+        out.push(ModelImage {
+            image_id,
+            camera_id,
+            name,
+            rotation: UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                q[0], q[1], q[2], q[3],
+            )),
+            translation: Vector3::new(t[0], t[1], t[2]),
+        });
+    }
+    Ok(out)
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    path: &'a Path,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        ensure!(
+            self.at + n <= self.bytes.len(),
+            "{}: truncated at byte {}",
+            self.path.display(),
+            self.at
+        );
+        self.at += n;
+        Ok(&self.bytes[self.at - n..self.at])
+    }
+    fn skip(&mut self, n: usize) -> Result<()> {
+        self.take(n).map(|_| ())
+    }
+    fn u32(&mut self) -> Result<u32> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn u64(&mut self) -> Result<u64> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn f64(&mut self) -> Result<f64> {
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn name(&mut self) -> Result<String> {
+        let rest = &self.bytes[self.at..];
+        let end = rest
+            .iter()
+            .position(|&b| b == 0)
+            .with_context(|| format!("{}: unterminated name", self.path.display()))?;
+        let name = String::from_utf8_lossy(&rest[..end]).into_owned();
+        self.at += end + 1;
+        Ok(name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_text_model_with_empty_point_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("images.txt"),
+            "# comment\n# Number of images: 2\n\
+             1 1 0 0 0 1 2 3 1 a.jpg\n\
+             10.5 20.5 -1\n\
+             2 0 1 0 0 0 0 1 1 b c.jpg\n\n",
+        )
+        .unwrap();
+        let images = read_text_images(dir.path()).unwrap();
+        assert_eq!(images.len(), 2);
+        assert_eq!(images[0].name, "a.jpg");
+        assert_eq!(images[1].name, "b c.jpg");
+        assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
+        assert!((images[1].centre() - Vector3::new(0.0, 0.0, 1.0)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn binary_and_text_agree_and_sub_models_are_found() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("1");
+        std::fs::create_dir_all(&model).unwrap();
+        let mut bin = 1u64.to_le_bytes().to_vec();
+        bin.extend(7u32.to_le_bytes());
+        for x in [1.0f64, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0] {
+            bin.extend(x.to_le_bytes());
+        }
+        bin.extend(2u32.to_le_bytes());
+        bin.extend(b"a b.png\0");
+        bin.extend(1u64.to_le_bytes());
+        bin.extend([0u8; 24]);
+        std::fs::write(model.join("images.bin"), &bin).unwrap();
+        assert_eq!(model_dirs(dir.path()).unwrap(), vec![model.clone()]);
+        let images = read_images(&model).unwrap();
+        assert_eq!(
+            (
+                images[0].image_id,
+                images[0].camera_id,
+                images[0].name.as_str()
+            ),
+            (7, 2, "a b.png")
+        );
+        assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
+        std::fs::write(model.join("images.bin"), &bin[..bin.len() - 1]).unwrap();
+        assert!(read_images(&model)
+            .unwrap_err()
+            .to_string()
+            .contains("truncated"));
+    }
+}
