@@ -8,7 +8,7 @@ use std::time::Instant;
 use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::database::Database;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
-use vgsel_colmap::{graph_file, prune, report::Report, rewrite, synth};
+use vgsel_colmap::{graph_file, prune, report::Report, rewrite, synth, synthetic_graph};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -55,6 +55,30 @@ enum Command {
 enum GenerateCommand {
     /// A matched COLMAP 3.8 database of cameras orbiting a synthetic scene, with its ground truth.
     Database(GenerateDatabaseArgs),
+    /// A synthetic view graph of the paper's supplement in the `solve` text format.
+    Graph(GenerateGraphArgs),
+}
+
+#[derive(Args)]
+struct GenerateGraphArgs {
+    /// The graph file to write.
+    #[arg(long, value_name = "FILE")]
+    output: PathBuf,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
+    images: u64,
+    #[arg(long)]
+    pairs: u64,
+    /// Images along a line (a facade) or a closed loop (around a building).
+    #[arg(long, value_enum, default_value = "loop")]
+    arrangement: GraphArrangement,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum GraphArrangement {
+    Linear,
+    Loop,
 }
 
 #[derive(Args)]
@@ -205,6 +229,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => run_inspect(&args),
         Command::Solve(args) => run_solve(&args),
         Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
+        Command::Generate(GenerateCommand::Graph(args)) => run_generate_graph(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -429,4 +454,21 @@ fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
         synth::write_gt_model(&gt, dir)?;
     }
     Ok(())
+}
+
+fn run_generate_graph(args: &GenerateGraphArgs) -> Result<()> {
+    let (n, e) = (args.images, args.pairs);
+    if e > n * (n - 1) / 2 {
+        bail!(
+            "--pairs {e} do not fit {n} images (at most {})",
+            n * (n - 1) / 2
+        );
+    }
+    let arrangement = match args.arrangement {
+        GraphArrangement::Linear => synthetic_graph::Arrangement::Linear,
+        GraphArrangement::Loop => synthetic_graph::Arrangement::Loop,
+    };
+    let problem = synthetic_graph::generate(n as usize, e as usize, arrangement, args.seed);
+    std::fs::write(&args.output, graph_file::write(&problem))
+        .with_context(|| format!("cannot write graph {}", args.output.display()))
 }
