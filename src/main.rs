@@ -105,6 +105,13 @@ struct GenerateDatabaseArgs {
         default_value_t = 6000
     )]
     num_points: usize,
+    /// Half-angle of the cone a point is seen from: narrower means fewer pairs per image.
+    #[arg(
+        long = "view_cone_degrees",
+        visible_alias = "view-cone-degrees",
+        default_value_t = 55.0
+    )]
+    view_cone_degrees: f64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
 }
@@ -445,6 +452,7 @@ fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
     let spec = synth::SceneSpec {
         num_images: args.num_images,
         num_points: args.num_points,
+        view_cone_degrees: args.view_cone_degrees,
         seed: args.seed,
         ..Default::default()
     };
