@@ -27,7 +27,12 @@ fn scene() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
     let keypoints = (0..IMAGES)
         .map(|_| {
             (0..KEYPOINTS)
-                .map(|_| [rng.gen_range(0.0..SIZE.0 as f32), rng.gen_range(0.0..SIZE.1 as f32)])
+                .map(|_| {
+                    [
+                        rng.gen_range(0.0..SIZE.0 as f32),
+                        rng.gen_range(0.0..SIZE.1 as f32),
+                    ]
+                })
                 .collect()
         })
         .collect();
