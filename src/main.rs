@@ -13,7 +13,7 @@ use vgsel_colmap::search::{self, Criteria, FlowRule};
 use vgsel_colmap::{
     eval, export, graph_file, plots, prune,
     report::{Outputs, Report},
-    rewrite, synth,
+    rewrite, synth, synthetic_graph,
 };
 
 const EXAMPLES: &str = "\
@@ -123,6 +123,30 @@ struct EvalArgs {
 enum GenerateCommand {
     /// A matched COLMAP 3.8 database of cameras orbiting a synthetic scene, with its ground truth.
     Database(GenerateDatabaseArgs),
+    /// A synthetic view graph of the paper's supplement in the `solve` text format.
+    Graph(GenerateGraphArgs),
+}
+
+#[derive(Args)]
+struct GenerateGraphArgs {
+    /// The graph file to write.
+    #[arg(long, value_name = "FILE")]
+    output: PathBuf,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
+    images: u64,
+    #[arg(long)]
+    pairs: u64,
+    /// Images along a line (a facade) or a closed loop (around a building).
+    #[arg(long, value_enum, default_value = "loop")]
+    arrangement: GraphArrangement,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum GraphArrangement {
+    Linear,
+    Loop,
 }
 
 #[derive(Args)]
@@ -149,6 +173,13 @@ struct GenerateDatabaseArgs {
         default_value_t = 6000
     )]
     num_points: usize,
+    /// Half-angle of the cone a point is seen from: narrower means fewer pairs per image.
+    #[arg(
+        long = "view_cone_degrees",
+        visible_alias = "view-cone-degrees",
+        default_value_t = 55.0
+    )]
+    view_cone_degrees: f64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
 }
@@ -313,6 +344,7 @@ fn main() -> ExitCode {
         Command::Solve(args) => run_solve(&args),
         Command::Eval(args) => run_eval(&args),
         Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
+        Command::Generate(GenerateCommand::Graph(args)) => run_generate_graph(&args),
         Command::Export(args) => run_export(&args, quiet, &progress),
         Command::Completions { shell } => {
             let mut script = Vec::new();
@@ -591,6 +623,7 @@ fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
     let spec = synth::SceneSpec {
         num_images: args.num_images,
         num_points: args.num_points,
+        view_cone_degrees: args.view_cone_degrees,
         seed: args.seed,
         ..Default::default()
     };
@@ -606,4 +639,21 @@ fn run_eval(args: &EvalArgs) -> Result<()> {
     let scores = eval::score(&args.model, &args.ground_truth)?;
     println!("{}", serde_json::to_string_pretty(&scores)?);
     Ok(())
+}
+
+fn run_generate_graph(args: &GenerateGraphArgs) -> Result<()> {
+    let (n, e) = (args.images, args.pairs);
+    if e > n * (n - 1) / 2 {
+        bail!(
+            "--pairs {e} do not fit {n} images (at most {})",
+            n * (n - 1) / 2
+        );
+    }
+    let arrangement = match args.arrangement {
+        GraphArrangement::Linear => synthetic_graph::Arrangement::Linear,
+        GraphArrangement::Loop => synthetic_graph::Arrangement::Loop,
+    };
+    let problem = synthetic_graph::generate(n as usize, e as usize, arrangement, args.seed);
+    std::fs::write(&args.output, graph_file::write(&problem))
+        .with_context(|| format!("cannot write graph {}", args.output.display()))
 }
