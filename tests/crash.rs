@@ -14,8 +14,8 @@ mod common;
 use common::{dump, schema, table_names, Row};
 use rand::{Rng, SeedableRng};
 use std::os::unix::process::ExitStatusExt;
-use std::path::Path;
-use std::process::{Command, Stdio};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 use vgsel_colmap::synth::{generate, SceneSpec};
 
@@ -108,15 +108,25 @@ struct Tally {
     exited_before_kill: usize,
 }
 
-#[test]
-fn sigkill_at_random_moments_never_loses_or_corrupts_the_database() {
+/// A generated database, the reference prune of a copy, and its timings.
+struct Setup {
+    root: tempfile::TempDir,
+    original: PathBuf,
+    original_content: Content,
+    pruned_content: Content,
+    /// A whole prune (process start to exit) and its write stage.
+    whole: Duration,
+    write: Duration,
+    rng: rand_chacha::ChaCha8Rng,
+    runs: usize,
+}
+
+fn setup(test: &str) -> Setup {
     let runs = env_or("VGSEL_CRASH_RUNS", 20);
     let num_images = env_or("VGSEL_CRASH_IMAGES", 40);
     let seed: u64 = std::env::var("VGSEL_CRASH_SEED")
         .map_or_else(|_| rand::random(), |v| v.parse().expect("VGSEL_CRASH_SEED"));
-    eprintln!("crash test: {runs} runs, {num_images} images, VGSEL_CRASH_SEED={seed}");
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-
+    eprintln!("{test}: {runs} runs, {num_images} images, VGSEL_CRASH_SEED={seed}");
     let root = tempfile::tempdir().unwrap();
     let original = root.path().join("original.db");
     let spec = SceneSpec {
@@ -126,9 +136,6 @@ fn sigkill_at_random_moments_never_loses_or_corrupts_the_database() {
         ..Default::default()
     };
     generate(&spec, &original).unwrap();
-    let original_content = content(&original);
-
-    // The reference prune, and how long a whole prune and its write take.
     let reference = root.path().join("reference.db");
     std::fs::copy(&original, &reference).unwrap();
     let report = root.path().join("report.json");
@@ -141,32 +148,101 @@ fn sigkill_at_random_moments_never_loses_or_corrupts_the_database() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let write = Duration::from_secs_f64(report["timings"]["write"].as_f64().unwrap());
-    let pruned_content = content(&reference);
+    let setup = Setup {
+        original_content: content(&original),
+        pruned_content: content(&reference),
+        root,
+        original,
+        whole,
+        write,
+        rng: rand_chacha::ChaCha8Rng::seed_from_u64(seed),
+        runs,
+    };
     assert_ne!(
-        pruned_content.0, original_content.0,
+        setup.pruned_content.0, setup.original_content.0,
         "the prune changed nothing"
     );
+    setup
+}
 
-    let mut tally = Tally::default();
-    for run in 0..runs {
-        let dir = root.path().join(format!("run-{run}"));
-        std::fs::create_dir(&dir).unwrap();
-        let db = dir.join("database.db");
-        let journal = dir.join("database.db-journal");
-        std::fs::copy(&original, &db).unwrap();
-        let mut child = prune_command(&db, &[]).spawn().unwrap();
+impl Setup {
+    /// Kills `child` at a random moment: on even runs uniformly over a whole prune, on odd runs
+    /// once `journal` exists (the write transaction has begun), uniformly over the write.
+    /// Returns whether the kill came before the prune finished by itself.
+    fn kill_at_random(&mut self, run: usize, mut child: Child, journal: &Path) -> bool {
         if run % 2 == 0 {
-            std::thread::sleep(whole.mul_f64(rng.gen_range(0.0..1.1)));
+            std::thread::sleep(self.whole.mul_f64(self.rng.gen_range(0.0..1.1)));
         } else {
             while !journal.exists() && child.try_wait().unwrap().is_none() {
                 std::thread::sleep(Duration::from_micros(100));
             }
-            std::thread::sleep(write.mul_f64(rng.gen_range(0.0..1.0)));
+            std::thread::sleep(self.write.mul_f64(self.rng.gen_range(0.0..1.0)));
         }
         child.kill().unwrap();
         let status = child.wait().unwrap();
-        if status.signal().is_none() {
-            assert!(status.success(), "run {run}: prune failed on its own");
+        assert!(
+            status.signal().is_some() || status.success(),
+            "run {run}: prune failed on its own"
+        );
+        status.signal().is_some()
+    }
+}
+
+/// SIGKILL during `--output`: the input stays byte-identical, OUT is absent or the complete
+/// prune, and only temporary files named after OUT can be left beside it.
+#[test]
+fn sigkill_during_output_never_touches_the_input() {
+    let mut setup = setup("--output crash test");
+    let input_bytes = std::fs::read(&setup.original).unwrap();
+    let (mut absent, mut complete) = (0, 0);
+    for run in 0..setup.runs / 2 {
+        let dir = setup.root.path().join(format!("out-{run}"));
+        std::fs::create_dir(&dir).unwrap();
+        let out = dir.join("out.db");
+        let child = prune_command(&setup.original, &["--output", out.to_str().unwrap()])
+            .spawn()
+            .unwrap();
+        setup.kill_at_random(run, child, &dir.join(".out.db.vgsel-tmp-journal"));
+        assert!(
+            std::fs::read(&setup.original).unwrap() == input_bytes,
+            "run {run}"
+        );
+        for name in file_names(&dir) {
+            assert!(
+                name == "out.db"
+                    || name.starts_with(".out.db.vgsel-tmp")
+                    || name.starts_with("..out.db.vgsel-tmp"),
+                "run {run}: {name}"
+            );
+        }
+        if out.exists() {
+            integrity_ok(&out);
+            assert!(content(&out) == setup.pruned_content, "run {run}");
+            complete += 1;
+        } else {
+            absent += 1;
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    eprintln!("--output crash test: OUT absent {absent}, complete {complete}");
+}
+
+#[test]
+fn sigkill_at_random_moments_never_loses_or_corrupts_the_database() {
+    let mut setup = setup("crash test");
+    let (original_content, pruned_content) =
+        (setup.original_content.clone(), setup.pruned_content.clone());
+    let runs = setup.runs;
+    let root = setup.root.path().to_path_buf();
+    let mut tally = Tally::default();
+    for run in 0..runs {
+        let dir = root.join(format!("run-{run}"));
+        std::fs::create_dir(&dir).unwrap();
+        let db = dir.join("database.db");
+        let journal = dir.join("database.db-journal");
+        std::fs::copy(&setup.original, &db).unwrap();
+        let child = prune_command(&db, &[]).spawn().unwrap();
+        if !setup.kill_at_random(run, child, &journal) {
             tally.exited_before_kill += 1;
         }
         // What a SIGKILL leaves: at most the rollback journal beside the database.
@@ -194,7 +270,7 @@ fn sigkill_at_random_moments_never_loses_or_corrupts_the_database() {
                 .unwrap();
         }
         assert_eq!(file_names(&dir), ["database.db"], "run {run}");
-        colmap_reads(&db, &root.path().join("colmap"));
+        colmap_reads(&db, &root.join("colmap"));
         let now = content(&db);
         if now == original_content {
             tally.original += 1;
