@@ -77,6 +77,11 @@ fn ok(args: &[&str]) -> Output {
     out
 }
 
+/// `prune` of `db` into the copy `out`, quietly.
+fn prune_to<'a>(db: &'a Path, out: &'a Path) -> Vec<&'a str> {
+    vec!["prune", "--database_path", s(db), "--output", s(out), "-q"]
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
@@ -99,6 +104,24 @@ const FEW_PAIRS: [&str; 2] = ["--min_pairs_per_image", "2"];
 
 /// The hand-made fixture's pairs have 2 to 4 inliers: count them all as edges.
 const FIXTURE_EDGES: [&str; 2] = ["--min_num_matches", "1"];
+
+/// A database (`made`: directory and path) changed by `sql` is refused by `prune` with
+/// `expected`; returns it for more checks.
+fn refused_after(
+    made: (TempDir, PathBuf),
+    sql: &str,
+    extra: &[&str],
+    expected: &str,
+) -> (TempDir, PathBuf) {
+    exec(&made.1, sql);
+    assert_has(&prune_refused(made.0.path(), &made.1, extra), expected);
+    made
+}
+
+/// The fixture (all its pairs made edges) changed by `sql` is refused with `expected`.
+fn fixture_refused(layout: Layout, sql: &str, expected: &str) {
+    refused_after(fixture(layout), sql, &FIXTURE_EDGES, expected);
+}
 
 fn assert_has(line: &str, what: &str) {
     assert!(line.contains(what), "expected {what:?} in: {line}");
@@ -169,11 +192,8 @@ fn sqlite_without_colmap_tables() {
 
 #[test]
 fn no_verified_pairs() {
-    let (dir, db) = scene();
-    exec(&db, "DELETE FROM two_view_geometries");
-    let line = prune_refused(dir.path(), &db, &[]);
-    assert_has(&line, "no verified image pairs");
-    assert_has(&line, "run a COLMAP matcher first");
+    let expected = "no verified image pairs in two_view_geometries: run a COLMAP matcher first";
+    refused_after(scene(), "DELETE FROM two_view_geometries", &[], expected);
 }
 
 #[test]
@@ -209,34 +229,31 @@ fn blob_size_disagrees_with_rows_and_cols() {
 
 #[test]
 fn match_index_beyond_the_keypoints() {
-    let (dir, db) = fixture(Layout::V38);
     // Image 1 keeps 5 of its 10 keypoints (6 float32 each); pair (1, 2) has inlier 9.
-    exec(
-        &db,
+    fixture_refused(
+        Layout::V38,
         "UPDATE keypoints SET rows = 5, data = substr(data, 1, 120) WHERE image_id = 1",
+        "pair (1, 2): inlier keypoint index 9 >= 5",
     );
-    let line = prune_refused(dir.path(), &db, &FIXTURE_EDGES);
-    assert_has(&line, "pair (1, 2): inlier keypoint index 9 >= 5");
 }
 
 #[test]
 fn keypoints_with_unsupported_cols() {
-    let (dir, db) = fixture(Layout::V38);
     // 10 x 6 float32 re-labelled 20 x 3: the size still agrees, the layout does not.
-    exec(
-        &db,
+    fixture_refused(
+        Layout::V38,
         "UPDATE keypoints SET rows = 20, cols = 3 WHERE image_id = 1",
+        "keypoints of image 1: 3 columns, expected 2, 4 or 6",
     );
-    let line = prune_refused(dir.path(), &db, &FIXTURE_EDGES);
-    assert_has(&line, "keypoints of image 1: 3 columns, expected 2, 4 or 6");
 }
 
 #[test]
 fn unknown_camera_model() {
-    let (dir, db) = fixture(Layout::Latest);
-    exec(&db, "UPDATE cameras SET model = 99 WHERE camera_id = 2");
-    let line = prune_refused(dir.path(), &db, &FIXTURE_EDGES);
-    assert_has(&line, "camera 2: unknown camera model 99");
+    fixture_refused(
+        Layout::Latest,
+        "UPDATE cameras SET model = 99 WHERE camera_id = 2",
+        "camera 2: unknown camera model 99",
+    );
 }
 
 /// Documented behaviour: the general preset does not read F/E/H, so non-finite matrices do not
@@ -279,11 +296,9 @@ fn nan_and_inf_in_f_e_h_are_kept_not_used() {
 
 #[test]
 fn pair_ids_naming_unknown_images() {
-    let (dir, db) = fixture(Layout::V38);
-    exec(&db, "DELETE FROM images WHERE image_id = 4");
-    let line = prune_refused(dir.path(), &db, &FIXTURE_EDGES);
-    assert_has(
-        &line,
+    fixture_refused(
+        Layout::V38,
+        "DELETE FROM images WHERE image_id = 4",
         "(images 3, 4) names image 4, which is not in the images table",
     );
 }
@@ -403,14 +418,10 @@ fn full_disk_leaves_everything_as_it_was() {
 
 #[test]
 fn newer_unknown_schema() {
-    let (dir, db) = scene();
-    exec(&db, "PRAGMA user_version = 5000000");
-    let line = prune_refused(dir.path(), &db, &[]);
-    assert_has(&line, "unknown schema version 5000000");
-    assert_has(
-        &refused(dir.path(), &["restore", "--database_path", s(&db)]),
-        "unknown schema",
-    );
+    let sql = "PRAGMA user_version = 5000000";
+    let (dir, db) = refused_after(scene(), sql, &[], "unknown schema version 5000000");
+    let restore = ["restore", "--database_path", s(&db)];
+    assert_has(&refused(dir.path(), &restore), "unknown schema");
 }
 
 #[test]
@@ -447,14 +458,7 @@ fn output_that_exists() {
     let (dir, db) = scene();
     let out = dir.path().join("out.db");
     std::fs::write(&out, "precious").unwrap();
-    let args = [
-        "prune",
-        "--database_path",
-        s(&db),
-        "--output",
-        s(&out),
-        "-q",
-    ];
+    let args = prune_to(&db, &out);
     assert_has(
         &refused(dir.path(), &args),
         "exists (add --overwrite to replace it)",
@@ -470,7 +474,7 @@ fn output_that_exists() {
     assert_has(&refused(dir.path(), &same), "is the input database itself");
 
     let before = snapshot(dir.path());
-    let mut args = args.to_vec();
+    let mut args = args;
     args.push("--overwrite");
     ok(&args);
     let after = snapshot(dir.path());
@@ -551,16 +555,8 @@ fn writes_only_the_paths_given() {
     let report = dir.path().join("report.json");
     let out = dir.path().join("pruned.db");
     let before = snapshot(dir.path());
-    let args = [
-        "prune",
-        "--database_path",
-        s(&db),
-        "--output",
-        s(&out),
-        "--report",
-        s(&report),
-        "-q",
-    ];
+    let mut args = prune_to(&db, &out);
+    args.extend(["--report", s(&report)]);
     ok(&args);
     let after = snapshot(dir.path());
     let mut expected: Vec<PathBuf> = before.keys().cloned().collect();
