@@ -86,13 +86,17 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// A small generated scene whose default prune invalidates pairs.
+/// A small generated scene whose prune with [`FEW_PAIRS`] invalidates pairs.
 fn scene() -> (TempDir, PathBuf) {
+    scene_of(12)
+}
+
+fn scene_of(num_images: usize) -> (TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let db = dir.path().join("scene.db");
     let spec = SceneSpec {
-        num_images: 12,
-        num_points: 1500,
+        num_images,
+        num_points: 125 * num_images,
         seed: 5,
         ..Default::default()
     };
@@ -394,7 +398,9 @@ fn prune_with_file_size_limit(limit: u64, args: &[&str]) -> Output {
 
 #[test]
 fn full_disk_leaves_everything_as_it_was() {
-    let (dir, db) = scene();
+    // Big enough that the transaction outgrows SQLite's page cache: the write then fails
+    // mid-transaction, not only at the commit, which is the case that left a hot journal.
+    let (dir, db) = scene_of(40);
     let limit = std::fs::metadata(&db).unwrap().len() + 4096;
     let before = snapshot(dir.path());
     let mut args = vec!["prune", "--database_path", s(&db), "-q"];
