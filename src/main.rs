@@ -375,6 +375,17 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
             );
         }
     }
+    if let Some(report) = &args.report {
+        // Checked before the database is written, so a bad path cannot fail the command after
+        // the prune took effect.
+        let parent = report.parent().filter(|p| !p.as_os_str().is_empty());
+        if report.is_dir() || parent.is_some_and(|p| !p.is_dir()) {
+            bail!(
+                "cannot write report {}: not a file in an existing directory",
+                report.display()
+            );
+        }
+    }
     let in_place = args.output.is_none() && !args.dry_run;
     let mut db = args.database.open(!in_place)?;
     let options = prune::Options {

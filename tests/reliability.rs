@@ -573,3 +573,17 @@ fn writes_only_the_paths_given() {
     ok(&["prune", "--database_path", s(&db), "--dry_run", "-q"]);
     assert!(snapshot(dir.path()) == after, "--dry_run wrote something");
 }
+
+/// A report path that cannot be written is refused before the database is touched.
+#[test]
+fn unwritable_report_path() {
+    let (dir, db) = scene();
+    let extra = [
+        ["--report", s(dir.path())],
+        ["--report", "no/such/dir/r.json"],
+    ];
+    for report in extra {
+        let line = prune_refused(dir.path(), &db, &[&FEW_PAIRS[..], &report[..]].concat());
+        assert_has(&line, "cannot write report");
+    }
+}
