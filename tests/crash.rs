@@ -170,7 +170,7 @@ impl Setup {
     /// once `journal` exists (the write transaction has begun), uniformly over the write.
     /// Returns whether the kill came before the prune finished by itself.
     fn kill_at_random(&mut self, run: usize, mut child: Child, journal: &Path) -> bool {
-        if run % 2 == 0 {
+        if run.is_multiple_of(2) {
             std::thread::sleep(self.whole.mul_f64(self.rng.gen_range(0.0..1.1)));
         } else {
             while !journal.exists() && child.try_wait().unwrap().is_none() {

@@ -546,7 +546,7 @@ fn disconnected_view_graph() {
         kept.iter().any(|p| p.1 <= 6) && kept.iter().any(|p| p.0 > 6),
         "{kept:?}"
     );
-    assert!(dump(&db, "vgsel_backup").len() > 0, "nothing invalidated");
+    assert!(!dump(&db, "vgsel_backup").is_empty(), "nothing invalidated");
     // In place: the database is the only file, still.
     assert_eq!(
         snapshot(dir.path()).keys().collect::<Vec<_>>(),
