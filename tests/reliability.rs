@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{dump, exec, fixture, table_names, Layout};
+use common::{dump, exec, fixture, ok, scene, table_names, vgsel, Layout};
 use rusqlite::Connection;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -13,13 +13,6 @@ use std::time::{Duration, Instant};
 use tempfile::TempDir;
 use vgsel_colmap::database::image_ids;
 use vgsel_colmap::synth::{generate, SceneSpec};
-
-fn vgsel(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
-        .args(args)
-        .output()
-        .expect("running vgsel-colmap")
-}
 
 /// Every file under `dir` (names relative to it) with its bytes.
 fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
@@ -67,16 +60,6 @@ fn prune_refused(dir: &Path, db: &Path, extra: &[&str]) -> String {
     refused(dir, &args)
 }
 
-fn ok(args: &[&str]) -> Output {
-    let out = vgsel(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
 /// `prune` of `db` into the copy `out`, quietly.
 fn prune_to<'a>(db: &'a Path, out: &'a Path) -> Vec<&'a str> {
     vec!["prune", "--database_path", s(db), "--output", s(out), "-q"]
@@ -86,11 +69,7 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// A small generated scene whose prune with [`FEW_PAIRS`] invalidates pairs.
-fn scene() -> (TempDir, PathBuf) {
-    scene_of(12)
-}
-
+/// A generated scene of `num_images` (common's `scene` has 16).
 fn scene_of(num_images: usize) -> (TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let db = dir.path().join("scene.db");
@@ -512,9 +491,9 @@ fn single_image() {
 #[test]
 fn disconnected_view_graph() {
     let (dir, db) = scene();
-    // Cut the 12-image orbit into images 1-6 and 7-12.
+    // Cut the 16-image orbit into images 1-8 and 9-16.
     let conn = Connection::open(&db).unwrap();
-    let cut = "DELETE FROM two_view_geometries WHERE (pair_id / 2147483647 <= 6) != (pair_id % 2147483647 <= 6)";
+    let cut = "DELETE FROM two_view_geometries WHERE (pair_id / 2147483647 <= 8) != (pair_id % 2147483647 <= 8)";
     conn.execute(cut, []).unwrap();
     drop(conn);
     let before = snapshot(dir.path());
@@ -543,7 +522,7 @@ fn disconnected_view_graph() {
         })
         .collect();
     assert!(
-        kept.iter().any(|p| p.1 <= 6) && kept.iter().any(|p| p.0 > 6),
+        kept.iter().any(|p| p.1 <= 8) && kept.iter().any(|p| p.0 > 8),
         "{kept:?}"
     );
     assert!(!dump(&db, "vgsel_backup").is_empty(), "nothing invalidated");
