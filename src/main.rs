@@ -4,7 +4,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::database::Database;
 use vgsel_colmap::overrides::{NameList, Overrides};
@@ -193,6 +193,17 @@ struct DatabaseArg {
         value_name = "DB"
     )]
     database_path: PathBuf,
+    /// Seconds to wait for another process's lock on DB (COLMAP GUI, a running matcher) before
+    /// giving up with an error.
+    #[arg(long = "lock_timeout", visible_alias = "lock-timeout", value_name = "SECONDS", default_value_t = 5.0, value_parser = lock_seconds)]
+    lock_timeout: f64,
+}
+
+impl DatabaseArg {
+    fn open(&self, read_only: bool) -> Result<Database> {
+        let timeout = Duration::from_secs_f64(self.lock_timeout);
+        Database::open_with_lock_timeout(&self.database_path, read_only, timeout)
+    }
 }
 
 #[derive(Args)]
@@ -333,6 +344,14 @@ fn non_negative(s: &str) -> Result<f64, String> {
     }
 }
 
+/// SQLite keeps its busy timeout in milliseconds as a C int, so a week is a safe upper bound.
+fn lock_seconds(s: &str) -> Result<f64, String> {
+    match non_negative(s) {
+        Ok(x) if x <= 604_800.0 => Ok(x),
+        _ => Err(format!("`{s}` is not a number of seconds in [0, 604800]")),
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let quiet = cli.quiet;
@@ -388,12 +407,19 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
             );
         }
     }
+    if let Some(report) = &args.report {
+        // Checked before the database is written, so a bad path cannot fail the command after
+        // the prune took effect.
+        let parent = report.parent().filter(|p| !p.as_os_str().is_empty());
+        if report.is_dir() || parent.is_some_and(|p| !p.is_dir()) {
+            bail!(
+                "cannot write report {}: not a file in an existing directory",
+                report.display()
+            );
+        }
+    }
     let in_place = args.output.is_none() && !args.dry_run;
-    let mut db = if in_place {
-        Database::open(input)?
-    } else {
-        Database::open_read_only(input)?
-    };
+    let mut db = args.database.open(!in_place)?;
     let options = prune::Options {
         min_num_matches: args.min_num_matches,
         rule: args.flow.rule(),
@@ -505,9 +531,11 @@ fn write_pruned_copy(
         drop(copy);
         std::fs::rename(&tmp, out)
             .with_context(|| format!("cannot move the pruned copy to {}", out.display()))
-    })();
+    })()
+    .with_context(|| format!("cannot write --output {}", out.display()));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
+        let _ = std::fs::remove_file(tmp.with_file_name(format!(".{name}.vgsel-tmp-journal")));
     }
     result
 }
@@ -517,7 +545,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 fn run_restore(args: &DatabaseArg, quiet: bool) -> Result<()> {
-    let mut db = Database::open(&args.database_path)?;
+    let mut db = args.open(false)?;
     let restored = rewrite::restore(&mut db)?;
     if !quiet {
         eprintln!(
@@ -529,7 +557,7 @@ fn run_restore(args: &DatabaseArg, quiet: bool) -> Result<()> {
 }
 
 fn run_inspect(args: &InspectArgs) -> Result<()> {
-    let db = Database::open_read_only(&args.database.database_path)?;
+    let db = args.database.open(true)?;
     let images = db.images()?;
     let pairs = db.verified_pairs()?;
     let graph = vgsel_colmap::view_graph::ViewGraph::build(&images, &pairs, args.min_num_matches);

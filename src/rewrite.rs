@@ -85,6 +85,25 @@ fn ensure_writable(db: &Database) -> Result<()> {
 /// a run record; all in one transaction.
 pub fn apply(db: &mut Database, invalidate: &[u64], run: &RunRecord) -> Result<()> {
     ensure_writable(db)?;
+    let result = apply_in_transaction(db, invalidate, run);
+    if result.is_err() {
+        settle_after_failure(db);
+    }
+    result
+}
+
+/// After a write fails (disk full, I/O error) SQLite can leave the rolled-back transaction's hot
+/// journal beside the database until the next statement. One read plays it back now, so a failed
+/// command leaves no `-journal` file behind; if that read fails too, the next open does it.
+fn settle_after_failure(db: &Database) {
+    let _ = db
+        .conn()
+        .query_row("SELECT count(*) FROM sqlite_master", [], |r| {
+            r.get::<_, i64>(0)
+        });
+}
+
+fn apply_in_transaction(db: &mut Database, invalidate: &[u64], run: &RunRecord) -> Result<()> {
     let path = db.path().to_path_buf();
     let p = path.as_path();
     let columns = db.layout().two_view_columns.clone();
@@ -161,6 +180,14 @@ pub fn restore(db: &mut Database) -> Result<usize> {
         bail!("database was not pruned by vgsel-colmap");
     }
     ensure_writable(db)?;
+    let result = restore_in_transaction(db);
+    if result.is_err() {
+        settle_after_failure(db);
+    }
+    result
+}
+
+fn restore_in_transaction(db: &mut Database) -> Result<usize> {
     let path = db.path().to_path_buf();
     let p = path.as_path();
     let columns = db.layout().two_view_columns.clone();
