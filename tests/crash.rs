@@ -91,6 +91,49 @@ fn colmap_reads(db: &Path, scratch: &Path) {
     );
 }
 
+/// `colmap mapper` opens `db` and loads exactly the pairs it should use (rows >= 15, its default
+/// --Mapper.min_num_matches). An impossible initial-pair threshold stops it right after loading.
+fn mapper_loads_valid_pairs(db: &Path, scratch: &Path) {
+    let _ = std::fs::remove_dir_all(scratch);
+    std::fs::create_dir_all(scratch.join("images")).unwrap();
+    std::fs::create_dir_all(scratch.join("sparse")).unwrap();
+    let out = Command::new("colmap")
+        .arg("mapper")
+        .arg("--database_path")
+        .arg(db)
+        .arg("--image_path")
+        .arg(scratch.join("images"))
+        .arg("--output_path")
+        .arg(scratch.join("sparse"))
+        .args([
+            "--Mapper.init_min_num_inliers",
+            "1000000",
+            "--Mapper.extract_colors",
+            "0",
+        ])
+        .output()
+        .expect("running colmap (scripts/install-deps.sh installs it)");
+    let log =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    let loaded: i64 = log
+        .lines()
+        .find_map(|l| l.strip_prefix("Loading matches... "))
+        .and_then(|rest| rest.split_whitespace().next()?.parse().ok())
+        .unwrap_or_else(|| panic!("colmap mapper did not load {db:?}: {log}"));
+    let valid: i64 = rusqlite::Connection::open(db)
+        .unwrap()
+        .query_row(
+            "SELECT count(*) FROM two_view_geometries WHERE rows >= 15",
+            [],
+            |r| r.get(0),
+        )
+        .unwrap();
+    assert_eq!(
+        loaded, valid,
+        "colmap mapper loaded another number of pairs from {db:?}"
+    );
+}
+
 fn integrity_ok(db: &Path) {
     let conn = rusqlite::Connection::open(db).unwrap();
     let check: String = conn
@@ -271,6 +314,7 @@ fn sigkill_at_random_moments_never_loses_or_corrupts_the_database() {
         }
         assert_eq!(file_names(&dir), ["database.db"], "run {run}");
         colmap_reads(&db, &root.join("colmap"));
+        mapper_loads_valid_pairs(&db, &root.join("mapper"));
         let now = content(&db);
         let was_pruned = now != original_content;
         if was_pruned {
