@@ -523,7 +523,8 @@ fn write_pruned_copy(
         .file_name()
         .context("--output names no file")?
         .to_string_lossy();
-    let tmp = out.with_file_name(format!(".{name}.vgsel-tmp"));
+    rewrite::remove_stale_temporaries(out);
+    let tmp = out.with_file_name(format!(".{name}.vgsel-tmp-{}", std::process::id()));
     let result = (|| {
         rewrite::copy_database(input, &tmp, true)?;
         let mut copy = Database::open(&tmp)?;
@@ -535,7 +536,11 @@ fn write_pruned_copy(
     .with_context(|| format!("cannot write --output {}", out.display()));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
-        let _ = std::fs::remove_file(tmp.with_file_name(format!(".{name}.vgsel-tmp-journal")));
+        let journal = format!(
+            "{}-journal",
+            tmp.file_name().unwrap_or_default().to_string_lossy()
+        );
+        let _ = std::fs::remove_file(tmp.with_file_name(journal));
     }
     result
 }

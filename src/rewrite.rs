@@ -237,6 +237,37 @@ pub fn last_run(db: &Database) -> Result<Option<RunRecordRow>> {
 /// Copies a COLMAP database for `prune --output`: SQLite's online backup API into a temporary
 /// file beside `dst`, then a rename, so `dst` is never half-written and a concurrent writer to
 /// `src` cannot tear the copy. Refuses an existing `dst` unless `overwrite`; never modifies `src`.
+/// Removes temporary copies of `dst` (and their journals) that a killed vgsel-colmap left beside
+/// it: names `.NAME.vgsel-tmp-PID…` or `..NAME.vgsel-tmp-PID…` whose process no longer runs.
+/// A SIGKILL cannot be cleaned up after at the time, so the next run does it.
+pub fn remove_stale_temporaries(dst: &Path) {
+    let (Some(dir), Some(name)) = (dst.parent(), dst.file_name()) else {
+        return;
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let prefix = format!(".{}.vgsel-tmp-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = file
+            .strip_prefix(&prefix)
+            .or_else(|| file.strip_prefix(&format!(".{prefix}")))
+        else {
+            continue;
+        };
+        let pid: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        if !pid.is_empty() && !Path::new("/proc").join(&pid).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
 pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
     // Validates src as a COLMAP database (with the usual one-line errors) and opens it read-only.
     let source = Database::open_read_only(src)?;

@@ -299,3 +299,34 @@ fn solve_on_the_triangle_fixture() {
     let message = fails(&["solve", "--graph", s(bad.path())]);
     assert!(message.contains("line 4"), "{message}");
 }
+
+#[test]
+fn output_removes_what_a_killed_run_left_and_keeps_a_live_runs_files() {
+    let (dir, db) = scene();
+    let out = dir.path().join("out.db");
+    // PIDs above the kernel's limit (4194304) never run; our own PID does.
+    let dead = [
+        ".out.db.vgsel-tmp-999999999",
+        "..out.db.vgsel-tmp-999999999.vgsel-tmp-999999999-journal",
+    ];
+    let live = format!(".out.db.vgsel-tmp-{}", std::process::id());
+    for name in dead.iter().copied().chain([live.as_str()]) {
+        std::fs::write(dir.path().join(name), b"left over").unwrap();
+    }
+    ok(&[
+        "prune",
+        "--database_path",
+        s(&db),
+        "--output",
+        s(&out),
+        "-q",
+    ]);
+    for name in dead {
+        assert!(!dir.path().join(name).exists(), "{name} left behind");
+    }
+    assert!(
+        dir.path().join(&live).exists(),
+        "a running process's file was removed"
+    );
+    assert!(out.exists());
+}
