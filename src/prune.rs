@@ -4,7 +4,8 @@
 use crate::costs::{self, CostModel, Costs};
 use crate::database::{pair_id, Database, Image, VerifiedPair};
 use crate::network::{PairArc, SelectionProblem};
-use crate::priors::{self, Inputs};
+use crate::priors::pairs::FocalEstimate;
+use crate::priors::{self, Inputs, PriorValues};
 use crate::search::{self, FlowRule, SearchResult};
 use crate::view_graph::ViewGraph;
 use anyhow::{bail, Context, Result};
@@ -34,6 +35,10 @@ pub struct Plan {
     pub pairs: Vec<VerifiedPair>,
     pub graph: ViewGraph,
     pub costs: Costs,
+    /// Raw pair prior values (the costs keep their fitness).
+    pub pair_priors: Vec<PriorValues>,
+    /// Focal lengths estimated where the database had only a guess.
+    pub focal_estimates: Vec<FocalEstimate>,
     pub search: SearchResult,
     /// pair_ids of the view-graph edges the selection leaves out.
     pub invalidate: Vec<u64>,
@@ -108,8 +113,10 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
         image_sizes,
     };
     let image_priors = priors::general_image_priors(&inputs);
-    let pair_priors = priors::general_pair_priors(&inputs);
-    let costs = costs::compute(&options.model, &image_priors, &pair_priors);
+    let camera_ids: Vec<u32> = graph.image_ids.iter().map(|id| camera_of[id]).collect();
+    let names = options.model.pair_prior_names();
+    let pair_priors = priors::pairs::compute(db, &inputs, &camera_ids, &names, stage)?;
+    let costs = costs::compute(&options.model, &image_priors, &pair_priors.values);
     timings.priors = t.elapsed().as_secs_f64();
 
     stage("solving the min-cost flow selection");
@@ -143,6 +150,8 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
         pairs,
         graph,
         costs,
+        pair_priors: pair_priors.values,
+        focal_estimates: pair_priors.focal_estimates,
         search,
         invalidate,
         timings,
