@@ -141,17 +141,19 @@ impl CostModel {
 
     /// The `disambiguation` preset (section 5.1): pair costs from context similarity, loop
     /// consistency and multiple motions (the two motion terms share one prior's weight and count
-    /// only where a second motion was found). The paper's literal context and loop values are
-    /// computed and reported with weight 0; the variants that separate true from false pairs on
-    /// duplicate structure carry the weight (docs/priors.md has the measurements). Image costs
-    /// are off (node constant 0) so that pair evidence alone decides.
+    /// only where a second motion was found). Every context and loop variant is computed and
+    /// reported; only those that measurably separate true from false pairs on the generated
+    /// duplicate scene carry weight (docs/priors.md has the AUCs): `loop_fraction` (rotation and
+    /// translation consistency of triangles) and the motion terms. The context variants measured
+    /// below 0.5 AUC there and have weight 0 (set them with `--weights`). Image costs are off
+    /// (node constant 0) so that pair evidence alone decides.
     pub fn disambiguation() -> CostModel {
         CostModel {
             image_priors: general_image_priors(),
             pair_priors: vec![
                 prior("context", Trapezoid::RISE, 0.0),
                 prior("context_hamming", Trapezoid::FALL, 0.0),
-                prior("context_outside", Trapezoid::RISE, 1.0),
+                prior("context_outside", Trapezoid::RISE, 0.0),
                 prior("loop", Trapezoid::RISE, 0.0),
                 prior("loop_fraction", Trapezoid::FRACTION, 1.0),
                 prior("motion_rotation", Trapezoid::MOTION_ROTATION, 0.5),

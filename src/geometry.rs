@@ -160,12 +160,14 @@ pub fn recover_pose(
     }))
 }
 
-/// RANSAC `findEssentialMat` on normalised correspondences (threshold in normalised units), then
-/// `recoverPose` on its inliers. Returns the pose and the RANSAC inlier mask.
+/// RANSAC `findEssentialMat` on normalised correspondences (threshold in normalised units, at
+/// most `iterations` samples), then `recoverPose` on its inliers. Returns the pose and the RANSAC
+/// inlier mask.
 pub fn estimate_pose(
     x1: &[[f64; 2]],
     x2: &[[f64; 2]],
     threshold: f64,
+    iterations: i32,
 ) -> Result<Option<(RelativePose, Vec<bool>)>> {
     if x1.len() < 5 {
         return Ok(None);
@@ -178,7 +180,7 @@ pub fn estimate_pose(
         opencv::calib3d::RANSAC,
         0.999,
         threshold,
-        1000,
+        iterations,
         &mut mask,
     )?;
     // Several solutions come stacked (3k x 3); the first is the best-supported.
@@ -310,7 +312,7 @@ pub fn pair_pose(g: &StoredGeometry) -> Result<Option<RelativePose>> {
             }
         }
     }
-    Ok(estimate_pose(g.x1, g.x2, g.threshold)?.map(|(p, _)| p))
+    Ok(estimate_pose(g.x1, g.x2, g.threshold, 1000)?.map(|(p, _)| p))
 }
 
 /// RANSAC homography on normalised correspondences: the matrix and its inlier count.

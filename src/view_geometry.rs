@@ -55,6 +55,9 @@ pub fn compute(
     cameras: Vec<CameraModel>,
     geometries: &[Option<&TwoViewGeometry>],
 ) -> Result<ViewGeometry> {
+    // Pairs run in parallel on rayon's threads; OpenCV's own thread pool on top of that would
+    // oversubscribe the cores.
+    opencv::core::set_num_threads(1)?;
     let normalised = cameras
         .par_iter()
         .zip(&inputs.keypoints)

@@ -6,9 +6,11 @@
 //! Three variants: `context` (cosine of w_ij and w_ji, the paper's), `context_hamming` (number of
 //! images on which the binarised vectors differ, the paper's alternative; lower is better) and
 //! `context_outside` (cosine, with U_i restricted to features outside the convex hull of the
-//! pair's inliers: the features on the duplicated object that this pair did not match still match
-//! both copies' images, which blurs the literal context; outside the matched region only the
-//! surroundings remain).
+//! pair's inliers, and each image k weighted by ln(N / (1 + degree of k)): the features on the
+//! duplicated object that this pair did not match still match both copies' images, which blurs
+//! the literal context, and images that match nearly everything (overviews) dominate a raw
+//! cosine while saying nothing about which instance a view sees; outside the matched region, with
+//! such images down-weighted as in TF-IDF, the distinct surroundings remain).
 
 use super::overlap::convex_hull;
 use super::{Inputs, PriorValues};
@@ -37,11 +39,12 @@ fn context_vector(
     other: u32,
     matched: &HashSet<u32>,
     keep: &dyn Fn(u32) -> bool,
+    weight: &dyn Fn(u32) -> f64,
 ) -> Context {
     let mut w = Context::new();
     for &(kp, k) in features {
         if k != other && !matched.contains(&kp) && keep(kp) {
-            *w.entry(k).or_default() += 1.0;
+            *w.entry(k).or_default() += weight(k);
         }
     }
     w
@@ -75,6 +78,12 @@ fn inside(hull: &[[f32; 2]], p: [f32; 2]) -> bool {
 
 pub fn compute(inputs: &Inputs) -> Vec<PriorValues> {
     let features = matched_features(inputs);
+    let n = inputs.graph.num_vertices() as f64;
+    let idf = |k: u32| {
+        (n / (1.0 + inputs.graph.degree(k as usize) as f64))
+            .ln()
+            .max(0.0)
+    };
     let rows: Vec<[f64; 3]> = (0..inputs.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
@@ -83,16 +92,17 @@ pub fn compute(inputs: &Inputs) -> Vec<PriorValues> {
             let (mi, mj): (HashSet<u32>, HashSet<u32>) =
                 inputs.edge_inliers(edge).map(|[a, b]| (a, b)).unzip();
             let all = |_: u32| true;
-            let wi = context_vector(&features[i], e.j, &mi, &all);
-            let wj = context_vector(&features[j], e.i, &mj, &all);
+            let one = |_: u32| 1.0;
+            let wi = context_vector(&features[i], e.j, &mi, &all, &one);
+            let wj = context_vector(&features[j], e.i, &mj, &all, &one);
             let hull = |v: usize, m: &HashSet<u32>| {
                 convex_hull(m.iter().map(|&k| inputs.keypoints[v][k as usize]).collect())
             };
             let (hi, hj) = (hull(i, &mi), hull(j, &mj));
             let out_i = |kp: u32| !inside(&hi, inputs.keypoints[i][kp as usize]);
             let out_j = |kp: u32| !inside(&hj, inputs.keypoints[j][kp as usize]);
-            let oi = context_vector(&features[i], e.j, &mi, &out_i);
-            let oj = context_vector(&features[j], e.i, &mj, &out_j);
+            let oi = context_vector(&features[i], e.j, &mi, &out_i, &idf);
+            let oj = context_vector(&features[j], e.i, &mj, &out_j, &idf);
             [cosine(&wi, &wj), hamming(&wi, &wj), cosine(&oi, &oj)]
         })
         .collect();

@@ -13,6 +13,10 @@ use std::collections::HashSet;
 
 /// Fewest correspondences a second motion needs (COLMAP's `min_num_inliers`).
 pub const MIN_SECOND_INLIERS: usize = 15;
+/// RANSAC samples for the second motion: enough to find a motion holding half of the leftover
+/// matches with 99.9% confidence; the leftovers are mostly outliers, so the default 1000 would
+/// run to the cap on every pair.
+const SECOND_ITERATIONS: i32 = 250;
 
 /// Rotation and translation-direction differences of two poses, degrees.
 pub fn motion_difference(a: &RelativePose, b: &RelativePose) -> (f64, f64) {
@@ -51,7 +55,12 @@ pub fn compute(
                 return Ok(absent);
             }
             Ok(
-                match estimate_pose(&x1, &x2, geometry.threshold(inputs, edge))? {
+                match estimate_pose(
+                    &x1,
+                    &x2,
+                    geometry.threshold(inputs, edge),
+                    SECOND_ITERATIONS,
+                )? {
                     Some((second, _)) if second.support >= MIN_SECOND_INLIERS => {
                         motion_difference(primary, &second)
                     }
@@ -85,10 +94,10 @@ mod tests {
         let r = Rotation3::from_euler_angles(0.0, 0.2, 0.0);
         let t = Vector3::new(1.0, 0.0, 0.0);
         let (x1, x2) = two_view(&r, &t, 50);
-        let primary = estimate_pose(&x1, &x2, 1e-3).unwrap().unwrap().0;
+        let primary = estimate_pose(&x1, &x2, 1e-3, 1000).unwrap().unwrap().0;
         let t2 = Vector3::new(1.0, 0.0, 0.0) + Vector3::new(0.0, 0.0, 4.0);
         let (y1, y2) = two_view(&r, &t2, 50);
-        let second = estimate_pose(&y1, &y2, 1e-3).unwrap().unwrap().0;
+        let second = estimate_pose(&y1, &y2, 1e-3, 1000).unwrap().unwrap().0;
         let (dr, dt) = motion_difference(&primary, &second);
         assert!(dr < 0.1, "{dr}");
         let expected = direction_angle_deg(&-(r.inverse() * t), &-(r.inverse() * t2));
