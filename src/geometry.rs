@@ -82,6 +82,14 @@ fn matrix3(m: &Mat) -> Result<Matrix3<f64>> {
     }))
 }
 
+fn vector3(m: &Mat) -> Result<Vector3<f64>> {
+    Ok(Vector3::new(
+        *m.at_2d::<f64>(0, 0)?,
+        *m.at_2d::<f64>(1, 0)?,
+        *m.at_2d::<f64>(2, 0)?,
+    ))
+}
+
 fn points(x: &[[f64; 2]]) -> Vector<Point2d> {
     x.iter().map(|p| Point2d::new(p[0], p[1])).collect()
 }
@@ -147,11 +155,7 @@ pub fn recover_pose(
     if support <= 0 {
         return Ok(None);
     }
-    let t = Vector3::new(
-        *t.at_2d::<f64>(0, 0)?,
-        *t.at_2d::<f64>(1, 0)?,
-        *t.at_2d::<f64>(2, 0)?,
-    );
+    let t = vector3(&t)?;
     Ok(Some(RelativePose {
         rotation: Rotation3::from_matrix(&matrix3(&r)?),
         translation: Unit::new_normalize(t),
@@ -216,18 +220,13 @@ pub fn pose_from_homography(
     let mut best: Option<RelativePose> = None;
     for k in 0..rs.len() {
         let r = Rotation3::from_matrix(&matrix3(&rs.get(k)?)?);
-        let tm = ts.get(k)?;
-        let t = Vector3::new(
-            *tm.at_2d::<f64>(0, 0)?,
-            *tm.at_2d::<f64>(1, 0)?,
-            *tm.at_2d::<f64>(2, 0)?,
-        );
+        let t = vector3(&ts.get(k)?)?;
         let support = x1
             .iter()
             .zip(x2)
             .filter(|(a, b)| triangulate(&r, &t, a, b).is_some())
             .count();
-        if t.norm() > 0.0 && best.as_ref().map_or(true, |b| support > b.support) {
+        if t.norm() > 0.0 && best.as_ref().is_none_or(|b| support > b.support) {
             best = Some(RelativePose {
                 rotation: r,
                 translation: Unit::new_normalize(t),
