@@ -4,6 +4,8 @@
 # reconstructs the full and the pruned database; `vgsel-colmap eval` scores both against the
 # ground truth. Installs what it needs on a fresh machine; prints one side-by-side table.
 # usage: scripts/demo.sh [WORKDIR]   (default target/demo)
+# The duplicate-structure scene with the disambiguation preset:
+#   SCENE=duplicate scripts/demo.sh target/demo-duplicate
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -13,10 +15,19 @@ work=${1:-target/demo}
 rm -rf "$work"
 mkdir -p "$work/images"
 
-"$bin" generate database --output "$work/full.db" --ground_truth "$work/gt" --num_images 48 --seed 1
+case "${SCENE:-orbit}" in
+  orbit)
+    generate=(--num_images 48 --seed 1)
+    prune=(--min_image_fraction 1 --min_pairs_per_image 5) ;;
+  duplicate)
+    generate=(--num_images 60 --num_points 9000 --seed 3 --duplicate_yaw 0)
+    prune=(--preset disambiguation --scores "$work/scores.csv") ;;
+  *) echo "SCENE must be orbit or duplicate" >&2; exit 2 ;;
+esac
+"$bin" generate database --output "$work/full.db" --ground_truth "$work/gt" "${generate[@]}"
 "$bin" inspect --database_path "$work/full.db"
 "$bin" prune --database_path "$work/full.db" --output "$work/pruned.db" \
-  --min_image_fraction 1 --min_pairs_per_image 5 --report "$work/report.json"
+  "${prune[@]}" --report "$work/report.json"
 
 declare -A seconds registered correct pairs median
 for variant in full pruned; do

@@ -7,6 +7,7 @@
 //! flow F stays the one free parameter.
 
 use crate::priors::PriorValues;
+use anyhow::{bail, Result};
 use serde::Serialize;
 
 /// The normalisation g of one prior: a trapezoid with breakpoints k1..k6: `low` below k2, rising
@@ -25,6 +26,48 @@ impl Trapezoid {
     pub const RISE: Trapezoid = Trapezoid {
         minmax: true,
         k: [0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+        high: 1.0,
+        low: 0.0,
+    };
+    /// "Less is better" on min-max scaled values (the Hamming context distance).
+    pub const FALL: Trapezoid = Trapezoid {
+        minmax: true,
+        k: [0.0, 0.0, 0.0, 0.0, 1.0, 1.0],
+        high: 1.0,
+        low: 0.0,
+    };
+    /// Raw values in [0, 1] taken as they are (a share of consistent triangles).
+    pub const FRACTION: Trapezoid = Trapezoid {
+        minmax: false,
+        ..Trapezoid::RISE
+    };
+    /// The authors' overlap g: the raw mean hull ratio, rising over [0, 1].
+    pub const OVERLAP: Trapezoid = Trapezoid::FRACTION;
+    /// Degrees: rise 2 -> 45, flat to 90, fall to 120.
+    pub const TRIANGULATION_ANGLE: Trapezoid = Trapezoid {
+        minmax: false,
+        k: [0.0, 2.0, 45.0, 90.0, 120.0, 180.0],
+        high: 1.0,
+        low: 0.0,
+    };
+    /// ‖HᵀH − I‖_F, min-max scaled: rise 0 -> 0.99, high to 1.01, fall to 2.
+    pub const HOMOGRAPHY: Trapezoid = Trapezoid {
+        minmax: true,
+        k: [0.0, 0.0, 0.99, 1.01, 2.0, 2.0],
+        high: 1.0,
+        low: 0.0,
+    };
+    /// Degrees between primary and secondary rotations: good to 5, nothing from 75.
+    pub const MOTION_ROTATION: Trapezoid = Trapezoid {
+        minmax: false,
+        k: [0.0, 0.0, 0.0, 5.0, 75.0, 180.0],
+        high: 1.0,
+        low: 0.0,
+    };
+    /// Degrees between primary and secondary translation directions: good to 5, nothing from 25.
+    pub const MOTION_POSITION: Trapezoid = Trapezoid {
+        minmax: false,
+        k: [0.0, 0.0, 0.0, 5.0, 25.0, 180.0],
         high: 1.0,
         low: 0.0,
     };
@@ -82,19 +125,80 @@ pub struct CostModel {
 
 impl CostModel {
     /// The paper's `general` preset (section 5.2) with the authors' breakpoints and uniform
-    /// weights, restricted to the priors that need no relative pose.
+    /// weights.
     pub fn general() -> CostModel {
-        let rise = |name| PriorModel {
-            name,
-            g: Trapezoid::RISE,
-            weight: 1.0,
-        };
         CostModel {
-            image_priors: vec![rise("degree"), rise("track_fraction"), rise("clustering")],
-            pair_priors: vec![rise("inliers"), rise("overlap")],
+            image_priors: general_image_priors(),
+            pair_priors: vec![
+                prior("inliers", Trapezoid::RISE, 1.0),
+                prior("triangulation_angle", Trapezoid::TRIANGULATION_ANGLE, 1.0),
+                prior("overlap", Trapezoid::OVERLAP, 1.0),
+                prior("homography", Trapezoid::HOMOGRAPHY, 1.0),
+            ],
             node_constant: 1.0,
         }
     }
+
+    /// The `disambiguation` preset (section 5.1): pair costs from context similarity, loop
+    /// consistency and multiple motions (the two motion terms share one prior's weight and count
+    /// only where a second motion was found). Every context and loop variant is computed and
+    /// reported; only those that measurably separate true from false pairs on the generated
+    /// duplicate scene carry weight (docs/priors.md has the AUCs): `loop_fraction` (rotation and
+    /// translation consistency of triangles) and the motion terms. The context variants measured
+    /// below 0.5 AUC there and have weight 0 (set them with `--weights`). Image costs are off
+    /// (node constant 0) so that pair evidence alone decides.
+    pub fn disambiguation() -> CostModel {
+        CostModel {
+            image_priors: general_image_priors(),
+            pair_priors: vec![
+                prior("context", Trapezoid::RISE, 0.0),
+                prior("context_hamming", Trapezoid::FALL, 0.0),
+                prior("context_outside", Trapezoid::RISE, 0.0),
+                prior("loop", Trapezoid::RISE, 0.0),
+                prior("loop_fraction", Trapezoid::FRACTION, 1.0),
+                prior("motion_rotation", Trapezoid::MOTION_ROTATION, 0.5),
+                prior("motion_position", Trapezoid::MOTION_POSITION, 0.5),
+            ],
+            node_constant: 0.0,
+        }
+    }
+
+    /// Sets a prior's weight; unknown names are an error listing the model's priors.
+    pub fn set_weight(&mut self, name: &str, weight: f64) -> Result<()> {
+        let all = self
+            .image_priors
+            .iter()
+            .chain(&self.pair_priors)
+            .map(|p| p.name)
+            .collect::<Vec<_>>()
+            .join(", ");
+        match self
+            .image_priors
+            .iter_mut()
+            .chain(self.pair_priors.iter_mut())
+            .find(|p| p.name == name)
+        {
+            Some(p) => p.weight = weight,
+            None => bail!("no prior `{name}` in this preset (it has {all})"),
+        }
+        Ok(())
+    }
+
+    /// Names of the pair priors, in cost order.
+    pub fn pair_prior_names(&self) -> Vec<&'static str> {
+        self.pair_priors.iter().map(|p| p.name).collect()
+    }
+}
+
+fn prior(name: &'static str, g: Trapezoid, weight: f64) -> PriorModel {
+    PriorModel { name, g, weight }
+}
+
+fn general_image_priors() -> Vec<PriorModel> {
+    ["degree", "track_fraction", "clustering"]
+        .into_iter()
+        .map(|n| prior(n, Trapezoid::RISE, 1.0))
+        .collect()
 }
 
 /// Costs of every image and pair, with each prior's fitness kept for reports.
@@ -126,7 +230,9 @@ pub fn compute(
     }
 }
 
-/// Each prior's fitness, and their weighted mean per item.
+/// Each prior's fitness, and their weighted mean per item. A NaN raw value means the prior does
+/// not apply to that item (no second motion found, no triangle): its fitness is NaN and the mean
+/// is taken over the priors that apply.
 fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorValues>, Vec<f64>) {
     let fitness: Vec<PriorValues> = models
         .iter()
@@ -135,25 +241,30 @@ fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorVal
                 .iter()
                 .find(|p| p.name == m.name)
                 .unwrap_or_else(|| panic!("no values for prior {}", m.name));
+            let fit = m.g.apply(&values.values);
             PriorValues {
                 name: m.name,
-                values: m.g.apply(&values.values),
+                values: fit
+                    .into_iter()
+                    .zip(&values.values)
+                    .map(|(f, r)| if r.is_nan() { f64::NAN } else { f })
+                    .collect(),
             }
         })
         .collect();
     let n = fitness.first().map_or(0, |f| f.values.len());
-    let total_weight: f64 = models.iter().map(|m| m.weight).sum();
     let mean = (0..n)
-        .map(|k| match total_weight {
-            w if w > 0.0 => {
+        .map(|k| {
+            let present = || {
                 models
                     .iter()
                     .zip(&fitness)
-                    .map(|(m, f)| m.weight * f.values[k])
-                    .sum::<f64>()
-                    / w
+                    .filter(move |(_, f)| !f.values[k].is_nan())
+            };
+            match present().map(|(m, _)| m.weight).sum::<f64>() {
+                w if w > 0.0 => present().map(|(m, f)| m.weight * f.values[k]).sum::<f64>() / w,
+                _ => 0.0,
             }
-            _ => 0.0,
         })
         .collect();
     (fitness, mean)
@@ -193,8 +304,15 @@ mod tests {
 
     #[test]
     fn weighted_mean_and_sign() {
-        let mut model = CostModel::general();
-        model.pair_priors[1].weight = 3.0;
+        let mut model = CostModel {
+            pair_priors: vec![
+                prior("inliers", Trapezoid::RISE, 1.0),
+                prior("overlap", Trapezoid::OVERLAP, 1.0),
+            ],
+            ..CostModel::general()
+        };
+        model.set_weight("overlap", 3.0).unwrap();
+        assert!(model.set_weight("nope", 1.0).is_err());
         let pairs = [
             PriorValues {
                 name: "inliers",
@@ -227,5 +345,30 @@ mod tests {
             .iter()
             .chain(&c.image_costs)
             .all(|&x| (-1.0..=0.0).contains(&x)));
+    }
+
+    #[test]
+    fn absent_values_leave_the_mean() {
+        let model = CostModel {
+            image_priors: vec![],
+            pair_priors: vec![
+                prior("loop_fraction", Trapezoid::FRACTION, 1.0),
+                prior("motion_rotation", Trapezoid::MOTION_ROTATION, 1.0),
+            ],
+            node_constant: 0.0,
+        };
+        let pairs = [
+            PriorValues {
+                name: "loop_fraction",
+                values: vec![0.5, 0.5],
+            },
+            PriorValues {
+                name: "motion_rotation",
+                values: vec![f64::NAN, 90.0],
+            },
+        ];
+        let c = compute(&model, &[], &pairs);
+        assert_eq!(c.pair_costs, vec![-0.5, -0.25]);
+        assert!(c.pair_fitness[1].values[0].is_nan());
     }
 }

@@ -7,10 +7,14 @@
 //! [`prune`] runs that pipeline; [`report`] describes what it did.
 
 pub mod align;
+pub mod camera;
 pub mod costs;
 pub mod database;
+pub mod duplicate_scene;
 pub mod eval;
 pub mod export;
+pub mod focal;
+pub mod geometry;
 pub mod graph_file;
 pub mod model;
 pub mod network;
@@ -21,8 +25,11 @@ pub mod progress;
 pub mod prune;
 pub mod report;
 pub mod rewrite;
+pub mod scores;
 pub mod search;
+pub mod separation;
 pub mod solver;
 pub mod synth;
 pub mod synthetic_graph;
+pub mod view_geometry;
 pub mod view_graph;

@@ -13,7 +13,7 @@ use vgsel_colmap::search::{self, Criteria, FlowRule};
 use vgsel_colmap::{
     eval, export, graph_file, plots, prune,
     report::{Outputs, Report},
-    rewrite, synth, synthetic_graph,
+    rewrite, scores, synth, synthetic_graph,
 };
 
 const EXAMPLES: &str = "\
@@ -182,6 +182,21 @@ struct GenerateDatabaseArgs {
     view_cone_degrees: f64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Duplicate-structure scene: two copies of the object, the second turned by this yaw
+    /// (degrees), with ground-truth pair labels; see `duplicate_scene`.
+    #[arg(
+        long = "duplicate_yaw",
+        visible_alias = "duplicate-yaw",
+        value_name = "DEG"
+    )]
+    duplicate_yaw: Option<f64>,
+    /// Store this focal length as an uncalibrated guess (prior_focal_length = 0, F only).
+    #[arg(
+        long = "stored_focal",
+        visible_alias = "stored-focal",
+        value_name = "PX"
+    )]
+    stored_focal: Option<f64>,
 }
 
 #[derive(Args)]
@@ -224,8 +239,36 @@ struct InspectArgs {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Preset {
-    /// Image priors degree, track fraction, clustering; pair priors inliers, overlap.
+    /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
+    /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
     General,
+    /// Pair priors context similarity, loop consistency, multiple motions, for scenes with
+    /// duplicate or symmetric structure. Search: 80% of images, 5 pairs per image.
+    Disambiguation,
+}
+
+impl Preset {
+    fn name(self) -> &'static str {
+        match self {
+            Preset::General => "general",
+            Preset::Disambiguation => "disambiguation",
+        }
+    }
+
+    fn model(self) -> CostModel {
+        match self {
+            Preset::General => CostModel::general(),
+            Preset::Disambiguation => CostModel::disambiguation(),
+        }
+    }
+
+    /// The paper's flow-search criteria: (image fraction, pairs per image).
+    fn criteria(self) -> (f64, f64) {
+        match self {
+            Preset::General => (0.9, 20.0),
+            Preset::Disambiguation => (0.8, 5.0),
+        }
+    }
 }
 
 #[derive(Args)]
@@ -233,21 +276,24 @@ struct FlowArgs {
     /// Use this total flow F instead of searching for it.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image"])]
     flow: Option<u64>,
-    /// Search: smallest F selecting at least this fraction of the view graph's images.
-    #[arg(long = "min_image_fraction", visible_alias = "min-image-fraction", default_value_t = 0.9, value_parser = fraction)]
-    min_image_fraction: f64,
-    /// Search: ... and at least this many pairs per image (capped at all pairs).
-    #[arg(long = "min_pairs_per_image", visible_alias = "min-pairs-per-image", default_value_t = 20.0, value_parser = non_negative)]
-    min_pairs_per_image: f64,
+    /// Search: smallest F selecting at least this fraction of the view graph's images
+    /// [default: 0.9, disambiguation preset 0.8].
+    #[arg(long = "min_image_fraction", visible_alias = "min-image-fraction", value_parser = fraction)]
+    min_image_fraction: Option<f64>,
+    /// Search: ... and at least this many pairs per image (capped at all pairs)
+    /// [default: 20, disambiguation preset 5].
+    #[arg(long = "min_pairs_per_image", visible_alias = "min-pairs-per-image", value_parser = non_negative)]
+    min_pairs_per_image: Option<f64>,
 }
 
 impl FlowArgs {
-    fn rule(&self) -> FlowRule {
+    /// The flow rule, with `defaults` (image fraction, pairs per image) for unset criteria.
+    fn rule(&self, defaults: (f64, f64)) -> FlowRule {
         match self.flow {
             Some(f) => FlowRule::Fixed(f),
             None => FlowRule::Criteria(Criteria {
-                min_image_fraction: self.min_image_fraction,
-                min_pairs_per_image: self.min_pairs_per_image,
+                min_image_fraction: self.min_image_fraction.unwrap_or(defaults.0),
+                min_pairs_per_image: self.min_pairs_per_image.unwrap_or(defaults.1),
             }),
         }
     }
@@ -278,6 +324,12 @@ struct PruneArgs {
     /// Which priors make the costs.
     #[arg(long, value_enum, default_value = "general")]
     preset: Preset,
+    /// Override prior weights: NAME=W[,NAME=W...] (names as in --scores' header).
+    #[arg(long, value_name = "NAME=W,...", value_parser = weights, default_value = "")]
+    weights: Weights,
+    /// Write each pair's raw and normalised prior values, cost and selection as CSV here.
+    #[arg(long, value_name = "FILE")]
+    scores: Option<PathBuf>,
     /// Write a JSON report here (schema: docs/report.md).
     #[arg(long, value_name = "FILE")]
     report: Option<PathBuf>,
@@ -328,6 +380,24 @@ struct SolveArgs {
     graph: PathBuf,
     #[command(flatten)]
     flow: FlowArgs,
+}
+
+#[derive(Clone, Debug)]
+struct Weights(Vec<(String, f64)>);
+
+fn weights(s: &str) -> Result<Weights, String> {
+    s.split(',')
+        .filter(|w| !w.is_empty())
+        .map(
+            |w| match w.split_once('=').map(|(n, x)| (n, non_negative(x))) {
+                Some((n, Ok(x))) => Ok((n.to_string(), x)),
+                _ => Err(format!(
+                    "`{w}` is not NAME=WEIGHT with a non-negative weight"
+                )),
+            },
+        )
+        .collect::<Result<_, _>>()
+        .map(Weights)
 }
 
 fn fraction(s: &str) -> Result<f64, String> {
@@ -420,12 +490,14 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     }
     let in_place = args.output.is_none() && !args.dry_run;
     let mut db = args.database.open(!in_place)?;
+    let mut model = args.preset.model();
+    for (name, w) in &args.weights.0 {
+        model.set_weight(name, *w)?;
+    }
     let options = prune::Options {
         min_num_matches: args.min_num_matches,
-        rule: args.flow.rule(),
-        model: match args.preset {
-            Preset::General => CostModel::general(),
-        },
+        rule: args.flow.rule(args.preset.criteria()),
+        model,
     };
     let stage = |s: &str| progress.stage(s);
     let overrides = args.overrides()?;
@@ -439,12 +511,16 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         plan.search.selection.flow
     ));
     let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
+    let criteria = match options.rule {
+        FlowRule::Criteria(c) => Some(c),
+        FlowRule::Fixed(_) => None,
+    };
     let parameters = serde_json::json!({
-        "preset": "general",
+        "preset": args.preset.name(),
         "min_num_matches": args.min_num_matches,
         "flow": args.flow.flow,
-        "min_image_fraction": args.flow.min_image_fraction,
-        "min_pairs_per_image": args.flow.min_pairs_per_image,
+        "min_image_fraction": criteria.map(|c| c.min_image_fraction),
+        "min_pairs_per_image": criteria.map(|c| c.min_pairs_per_image),
         "cost_model": options.model,
         "keep_pairs": path_text(&args.keep_pairs),
         "forbid_pairs": path_text(&args.forbid_pairs),
@@ -456,6 +532,9 @@ fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         std::fs::write(path, export::pairs_list(&plan))
             .with_context(|| format!("cannot write --pairs_out {}", path.display()))?;
         outputs.pairs_out = Some(path.display().to_string());
+    }
+    if let Some(path) = &args.scores {
+        scores::write(&plan, path)?;
     }
     if let Some(dir) = &args.plots {
         let files = plots::write(&plan, dir, progress)?;
@@ -636,7 +715,7 @@ fn run_solve(args: &SolveArgs) -> Result<()> {
     let problem =
         graph_file::parse(&text).with_context(|| format!("graph {}", args.graph.display()))?;
     let started = Instant::now();
-    let result = search::search(&problem, &args.flow.rule());
+    let result = search::search(&problem, &args.flow.rule(Preset::General.criteria()));
     let solve_seconds = started.elapsed().as_secs_f64();
     let selection = &result.selection;
     let value = serde_json::json!({
@@ -652,12 +731,23 @@ fn run_solve(args: &SolveArgs) -> Result<()> {
     Ok(())
 }
 
+/// Overview images of a generated duplicate scene (they link the two camera groups).
+const DUPLICATE_OVERVIEW_IMAGES: usize = 4;
+
 fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
     let spec = synth::SceneSpec {
         num_images: args.num_images,
         num_points: args.num_points,
         view_cone_degrees: args.view_cone_degrees,
         seed: args.seed,
+        layout: match args.duplicate_yaw {
+            Some(yaw_degrees) => synth::Layout::Duplicate {
+                yaw_degrees,
+                overview_images: DUPLICATE_OVERVIEW_IMAGES,
+            },
+            None => synth::Layout::Orbit,
+        },
+        stored_focal: args.stored_focal,
         ..Default::default()
     };
     let gt = synth::generate(&spec, &args.output)?;

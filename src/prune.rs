@@ -4,6 +4,7 @@
 use crate::costs::{self, CostModel, Costs};
 use crate::database::{pair_id, Database, Image, VerifiedPair};
 use crate::overrides::{Listed, Network, Overrides};
+use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, Inputs, PriorValues};
 use crate::search::{self, FlowRule, SearchResult};
 use crate::view_graph::ViewGraph;
@@ -37,6 +38,8 @@ pub struct Plan {
     pub image_priors: Vec<PriorValues>,
     pub pair_priors: Vec<PriorValues>,
     pub costs: Costs,
+    /// Focal lengths estimated where the database had only a guess.
+    pub focal_estimates: Vec<FocalEstimate>,
     /// The network the flow ran on (the view graph less the overrides' arcs).
     pub network: Network,
     pub overrides: Listed,
@@ -126,8 +129,10 @@ pub fn plan_with(
         image_sizes,
     };
     let image_priors = priors::general_image_priors(&inputs);
-    let pair_priors = priors::general_pair_priors(&inputs);
-    let costs = costs::compute(&options.model, &image_priors, &pair_priors);
+    let camera_ids: Vec<u32> = graph.image_ids.iter().map(|id| camera_of[id]).collect();
+    let names = options.model.pair_prior_names();
+    let pair_priors = priors::pairs::compute(db, &inputs, &camera_ids, &names, stage)?;
+    let costs = costs::compute(&options.model, &image_priors, &pair_priors.values);
     timings.priors = t.elapsed().as_secs_f64();
 
     stage("solving the min-cost flow selection");
@@ -150,7 +155,8 @@ pub fn plan_with(
         pairs,
         graph,
         image_priors,
-        pair_priors,
+        pair_priors: pair_priors.values,
+        focal_estimates: pair_priors.focal_estimates,
         costs,
         network,
         overrides: resolved.listed,

@@ -25,6 +25,9 @@
 //! between observations of equal appearance, and are true only when they come from the same 3D
 //! point. Today every point has its own appearance; a duplicate-structure scene only has to give
 //! two copies of an object the same appearance ids, and [`GtPair::true_pair`] labels the result.
+//! [`Layout::Duplicate`] is such a scene ([`crate::duplicate_scene`]). There, a pair's
+//! correspondences fall into motions (same point, or copy a's point matched to copy b's), and the
+//! verified inliers are the largest motion, as RANSAC would keep; the others stay in `matches`.
 
 use crate::model::ModelImage;
 use anyhow::{bail, ensure, Context, Result};
@@ -44,6 +47,8 @@ const MAX_NUM_IMAGES: u64 = 2_147_483_647;
 pub const SIMPLE_RADIAL: i32 = 2;
 /// TwoViewGeometry::CALIBRATED.
 pub const CONFIG_CALIBRATED: i32 = 2;
+/// TwoViewGeometry::UNCALIBRATED.
+pub const CONFIG_UNCALIBRATED: i32 = 3;
 
 /// What to generate. Every field has a default (see [`Default`]) sized for CI.
 #[derive(Clone, Debug)]
@@ -84,7 +89,26 @@ pub struct SceneSpec {
     pub relative_pose: bool,
     /// Random uint8 descriptors (rows = keypoints) instead of empty rows; the mapper ignores them.
     pub random_descriptors: bool,
+    /// Which scene.
+    pub layout: Layout,
+    /// Write this focal length with `prior_focal_length = 0` and UNCALIBRATED geometries (F, no
+    /// E), as COLMAP does for images without EXIF; the ground truth keeps `focal`.
+    pub stored_focal: Option<f64>,
     pub seed: u64,
+}
+
+/// The scene layout.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Layout {
+    /// Boxes on a ground disc, cameras on an orbit.
+    Orbit,
+    /// Two identical objects in distinct surroundings; see [`crate::duplicate_scene`].
+    Duplicate {
+        /// Yaw of the second copy relative to the first (0: a pure translation).
+        yaw_degrees: f64,
+        /// Images looking at both copies (the rest split between the two copies).
+        overview_images: usize,
+    },
 }
 
 impl Default for SceneSpec {
@@ -108,6 +132,8 @@ impl Default for SceneSpec {
             all_pairs: true,
             relative_pose: false,
             random_descriptors: false,
+            layout: Layout::Orbit,
+            stored_focal: None,
             seed: 0,
         }
     }
@@ -187,7 +213,7 @@ impl GroundTruth {
 
 /// A surface that points are sampled on.
 #[derive(Clone, Debug)]
-enum Surface {
+pub(crate) enum Surface {
     /// Box standing on the ground (bottom face not sampled), rotated by `yaw` about z.
     Box {
         centre: Vector3<f64>,
@@ -200,17 +226,19 @@ enum Surface {
 }
 
 #[derive(Clone, Debug)]
-struct ScenePoint {
-    position: Vector3<f64>,
+pub(crate) struct ScenePoint {
+    pub position: Vector3<f64>,
     /// Axis of the visibility cone (unit).
-    normal: Vector3<f64>,
+    pub normal: Vector3<f64>,
     /// Correspondences join observations of equal appearance.
-    appearance: u32,
+    pub appearance: u32,
+    /// Which copy of a duplicated object the point is on (0 elsewhere).
+    pub copy: u32,
 }
 
 /// The default scene: three boxes of different sizes near the centre on a ground disc, with
 /// `weight` the share of points.
-fn default_surfaces(spec: &SceneSpec) -> Vec<(Surface, f64)> {
+pub(crate) fn default_surfaces(spec: &SceneSpec) -> Vec<(Surface, f64)> {
     let r = spec.orbit_radius;
     vec![
         (
@@ -241,7 +269,7 @@ fn default_surfaces(spec: &SceneSpec) -> Vec<(Surface, f64)> {
     ]
 }
 
-fn sample_surface(
+pub(crate) fn sample_surface(
     surface: &Surface,
     n: usize,
     rng: &mut ChaCha8Rng,
@@ -317,6 +345,7 @@ fn build_points(spec: &SceneSpec, rng: &mut ChaCha8Rng) -> Vec<ScenePoint> {
                 position,
                 normal,
                 appearance,
+                copy: 0,
             });
         }
     }
@@ -325,7 +354,7 @@ fn build_points(spec: &SceneSpec, rng: &mut ChaCha8Rng) -> Vec<ScenePoint> {
 
 /// World-to-camera rotation of a camera at `centre` looking at `target`, z up in the world,
 /// COLMAP's camera axes (x right, y down, z forward).
-fn look_at(centre: &Vector3<f64>, target: &Vector3<f64>) -> Rotation3<f64> {
+pub(crate) fn look_at(centre: &Vector3<f64>, target: &Vector3<f64>) -> Rotation3<f64> {
     let forward = (target - centre).normalize();
     let right = forward.cross(&Vector3::z()).normalize();
     let down = forward.cross(&right);
@@ -370,8 +399,9 @@ fn build_cameras(spec: &SceneSpec, rng: &mut ChaCha8Rng) -> Vec<GtImage> {
         .collect()
 }
 
-/// Keypoint in image a, keypoint in image b (a < b), same 3D point.
-type Correspondence = (u32, u32, bool);
+/// Keypoint in image a, keypoint in image b (a < b), motion class: 0 for the same 3D point,
+/// 1 + 8 × copy in a + copy in b for a duplicate's copy matched to another copy.
+type Correspondence = (u32, u32, u32);
 
 /// Keypoints of one image: positions and, for each visible point, its keypoint index.
 struct ImageObservations {
@@ -498,8 +528,16 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
         );
     }
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-    let points = build_points(spec, &mut rng);
-    let images = build_cameras(spec, &mut rng);
+    let (points, images) = match spec.layout {
+        Layout::Orbit => {
+            let points = build_points(spec, &mut rng);
+            (points, build_cameras(spec, &mut rng))
+        }
+        Layout::Duplicate {
+            yaw_degrees,
+            overview_images,
+        } => crate::duplicate_scene::build(spec, yaw_degrees, overview_images, &mut rng),
+    };
     let camera = GtCamera {
         camera_id: 1,
         model_id: SIMPLE_RADIAL,
@@ -544,15 +582,18 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
     );
     let mut pairs_gt = Vec::new();
     {
+        let mut stored_params = camera.params.clone();
+        stored_params[0] = spec.stored_focal.unwrap_or(spec.focal);
         tx.execute(
             "INSERT INTO cameras(camera_id, model, width, height, params, prior_focal_length) \
-             VALUES (?1, ?2, ?3, ?4, ?5, 1)",
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
             params![
                 camera.camera_id,
                 camera.model_id,
                 camera.width,
                 camera.height,
-                f64_blob(&camera.params)
+                f64_blob(&stored_params),
+                spec.stored_focal.is_none()
             ],
         )?;
         let mut ins_image =
@@ -610,7 +651,12 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
                 let group = &by_appearance[points[pa as usize].appearance as usize];
                 for &(ib, kb, pb) in group {
                     if ib > a {
-                        buckets[ib as usize].push((ka, kb, pa == pb));
+                        let class = if pa == pb {
+                            0
+                        } else {
+                            1 + 8 * points[pa as usize].copy + points[pb as usize].copy
+                        };
+                        buckets[ib as usize].push((ka, kb, class));
                     }
                 }
             }
@@ -629,24 +675,35 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
                 let mut used1 = HashSet::new();
                 let mut used2 = HashSet::new();
                 let mut matches: Vec<[u32; 2]> = Vec::new();
+                let mut classes: Vec<u32> = Vec::new();
                 let mut true_ones: Vec<[u32; 2]> = Vec::new();
-                for &(k1, k2, same) in corr {
+                for &(k1, k2, class) in corr {
                     if !used1.contains(&k1) && !used2.contains(&k2) {
                         used1.insert(k1);
                         used2.insert(k2);
                         matches.push([k1, k2]);
-                        if same {
+                        classes.push(class);
+                        if class == 0 {
                             true_ones.push([k1, k2]);
                         }
                     }
                 }
-                // Inliers: every same-appearance correspondence (RANSAC cannot tell duplicates
-                // apart) minus a few it would miss.
+                // Inliers: the largest motion (RANSAC cannot tell duplicates apart, it keeps
+                // the best-supported motion) minus a few it would miss.
+                let mut sizes = std::collections::BTreeMap::new();
+                for &c in &classes {
+                    *sizes.entry(c).or_insert(0usize) += 1;
+                }
+                let largest = sizes
+                    .iter()
+                    .max_by_key(|(c, n)| (**n, std::cmp::Reverse(**c)));
+                let largest = largest.map_or(0, |(c, _)| *c);
                 let drop = spec.inlier_drop_fraction.clamp(0.0, 1.0);
                 let mut inliers: Vec<[u32; 2]> = matches
                     .iter()
-                    .filter(|_| !rng.gen_bool(drop))
-                    .copied()
+                    .zip(&classes)
+                    .filter(|(_, &c)| !rng.gen_bool(drop) && c == largest)
+                    .map(|(m, _)| *m)
                     .collect();
                 inliers.sort_unstable();
                 let num_kp1 = observations[a as usize].keypoints.len() as u32;
@@ -692,13 +749,17 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
                         (vec![0.0; 4], vec![0.0; 3])
                     };
                     ins_match.execute(params![pair_id, matches.len(), pairs_blob(&matches)])?;
+                    let (config, e) = match spec.stored_focal {
+                        None => (CONFIG_CALIBRATED, Some(matrix_blob(&e))),
+                        Some(_) => (CONFIG_UNCALIBRATED, None),
+                    };
                     ins_tvg.execute(params![
                         pair_id,
                         inliers.len(),
                         pairs_blob(&inliers),
-                        CONFIG_CALIBRATED,
+                        config,
                         matrix_blob(&f),
-                        matrix_blob(&e),
+                        e,
                         matrix_blob(&h),
                         f64_blob(&qvec),
                         f64_blob(&tvec)

@@ -2,13 +2,21 @@
 //! One module per prior; each returns one raw value per view-graph vertex or edge.
 //!
 //! The `general` preset (paper, section 5.2) uses the image priors degree, track fraction and
-//! clustering, and the pair priors inliers and overlap.
+//! clustering, and the pair priors inliers, overlap, triangulation angle and homography; the
+//! `disambiguation` preset (section 5.1) the pair priors context, loop and multiple motions.
+//! [`pairs::compute`] computes the pair priors a cost model names.
 
 pub mod clustering;
+pub mod context;
 pub mod degree;
+pub mod homography;
 pub mod inliers;
+pub mod loop_consistency;
+pub mod multiple_motions;
 pub mod overlap;
+pub mod pairs;
 pub mod track_fraction;
+pub mod triangulation_angle;
 
 use crate::database::VerifiedPair;
 use crate::view_graph::ViewGraph;
@@ -49,9 +57,4 @@ pub fn general_image_priors(inputs: &Inputs) -> Vec<PriorValues> {
         track_fraction::compute(inputs),
         clustering::compute(inputs.graph),
     ]
-}
-
-/// The pair priors of the `general` preset.
-pub fn general_pair_priors(inputs: &Inputs) -> Vec<PriorValues> {
-    vec![inliers::compute(inputs), overlap::compute(inputs)]
 }

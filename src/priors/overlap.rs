@@ -28,12 +28,26 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
     }
 }
 
-/// Area of the convex hull (Andrew's monotone chain, then the shoelace formula).
-pub fn convex_hull_area(mut points: Vec<[f32; 2]>) -> f64 {
+/// Area of the convex hull (shoelace formula).
+pub fn convex_hull_area(points: Vec<[f32; 2]>) -> f64 {
+    let hull = convex_hull(points);
+    let n = hull.len();
+    let twice: f64 = (0..n)
+        .map(|k| {
+            let (a, b) = (hull[k], hull[(k + 1) % n]);
+            a[0] as f64 * b[1] as f64 - b[0] as f64 * a[1] as f64
+        })
+        .sum();
+    0.5 * twice.abs()
+}
+
+/// Convex hull, counter-clockwise (x right, y up), by Andrew's monotone chain; empty for fewer
+/// than 3 distinct points.
+pub fn convex_hull(mut points: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
     points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
     points.dedup();
     if points.len() < 3 {
-        return 0.0;
+        return Vec::new();
     }
     let cross = |o: [f32; 2], a: [f32; 2], b: [f32; 2]| {
         (a[0] as f64 - o[0] as f64) * (b[1] as f64 - o[1] as f64)
@@ -55,14 +69,7 @@ pub fn convex_hull_area(mut points: Vec<[f32; 2]>) -> f64 {
         hull.push(p);
     }
     hull.pop();
-    let n = hull.len();
-    let twice: f64 = (0..n)
-        .map(|k| {
-            let (a, b) = (hull[k], hull[(k + 1) % n]);
-            a[0] as f64 * b[1] as f64 - b[0] as f64 * a[1] as f64
-        })
-        .sum();
-    0.5 * twice.abs()
+    hull
 }
 
 #[cfg(test)]

@@ -1,0 +1,63 @@
+//! Pair prior: infinite homography (paper, section 5.2). A homography normalised by the
+//! intrinsics and scaled to unit determinant is a rotation for a pure-rotation (panoramic) pair,
+//! so ‖HᵀH − I‖_F near 0 flags pairs whose epipolar geometry is ill-conditioned. As the authors
+//! do, the score is clamped at 2 and set to 1 when the homography has at most 16 inliers.
+//!
+//! The homography is fitted (RANSAC) to the pair's normalised inliers rather than read from the
+//! database: COLMAP stores H in pixels without its inlier count, and other tools store other
+//! things there.
+
+use super::{Inputs, PriorValues};
+use crate::geometry::estimate_homography;
+use crate::view_geometry::ViewGeometry;
+use anyhow::Result;
+use nalgebra::Matrix3;
+use rayon::prelude::*;
+
+/// Homographies with at most this many inliers score 1 (neither panoramic nor not).
+pub const MIN_HOMOGRAPHY_INLIERS: usize = 16;
+
+/// ‖HᵀH − I‖_F of a normalised homography scaled to unit determinant, clamped at 2.
+pub fn score(h: &Matrix3<f64>) -> f64 {
+    let det = h.determinant();
+    if det.abs() < 1e-12 {
+        return 2.0;
+    }
+    let h = h / det.cbrt();
+    (h.transpose() * h - Matrix3::identity()).norm().min(2.0)
+}
+
+pub fn compute(inputs: &Inputs, geometry: &ViewGeometry) -> Result<PriorValues> {
+    let values = (0..inputs.graph.edges.len())
+        .into_par_iter()
+        .map(|edge| {
+            let (x1, x2) = geometry.edge_points(inputs, edge);
+            Ok(
+                match estimate_homography(&x1, &x2, geometry.threshold(inputs, edge))? {
+                    Some((h, n)) if n > MIN_HOMOGRAPHY_INLIERS => score(&h),
+                    _ => 1.0,
+                },
+            )
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(PriorValues {
+        name: "homography",
+        values,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Rotation3, Vector3};
+
+    #[test]
+    fn rotation_scores_zero_translation_does_not() {
+        let r = Rotation3::from_euler_angles(0.1, -0.4, 0.2);
+        assert!(score(&(r.matrix() * 3.0)) < 1e-9);
+        let plane =
+            r.matrix() + Vector3::new(0.5, 0.0, 0.0) * Vector3::new(0.0, 0.0, 1.0).transpose();
+        assert!(score(&plane) > 0.3);
+        assert_eq!(score(&Matrix3::zeros()), 2.0);
+    }
+}

@@ -1,0 +1,168 @@
+//! Computes the pair priors a cost model names, and only those: the pose-based ones need the
+//! cameras, focal-length estimation and a relative pose per pair; multiple motions also need the
+//! raw matches.
+
+use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
+use super::{triangulation_angle, Inputs, PriorValues};
+use crate::camera::CameraModel;
+use crate::database::Database;
+use crate::focal::{self, FundamentalPair};
+use crate::view_geometry::{self, ViewGeometry};
+use anyhow::{Context, Result};
+use nalgebra::Matrix3;
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// A focal length estimated for a camera that had only a guess.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FocalEstimate {
+    pub camera_id: u32,
+    pub guessed: f64,
+    pub estimated: f64,
+}
+
+pub struct PairPriors {
+    pub values: Vec<PriorValues>,
+    pub focal_estimates: Vec<FocalEstimate>,
+}
+
+const POSE_PRIORS: [&str; 6] = [
+    "triangulation_angle",
+    "homography",
+    "loop",
+    "loop_fraction",
+    "motion_rotation",
+    "motion_position",
+];
+
+/// `camera_ids[v]` is the camera of vertex v. `stage` is told each long step.
+pub fn compute(
+    db: &Database,
+    inputs: &Inputs,
+    camera_ids: &[u32],
+    names: &[&str],
+    stage: &dyn Fn(&str),
+) -> Result<PairPriors> {
+    let wants = |n: &str| names.contains(&n);
+    let mut values = Vec::new();
+    if wants("inliers") {
+        values.push(inliers::compute(inputs));
+    }
+    if wants("overlap") {
+        values.push(overlap::compute(inputs));
+    }
+    if names.iter().any(|n| n.starts_with("context")) {
+        stage("computing context similarity");
+        values.extend(context::compute(inputs));
+    }
+    let mut focal_estimates = Vec::new();
+    if POSE_PRIORS.iter().any(|n| wants(n)) {
+        let (geometry, estimates) = relative_poses(db, inputs, camera_ids, stage)?;
+        focal_estimates = estimates;
+        if wants("triangulation_angle") {
+            values.push(triangulation_angle::compute(inputs, &geometry));
+        }
+        if wants("homography") {
+            stage("fitting homographies");
+            values.push(homography::compute(inputs, &geometry)?);
+        }
+        if wants("loop") || wants("loop_fraction") {
+            stage("checking loop consistency");
+            values.extend(loop_consistency::compute(inputs, &geometry.poses));
+        }
+        if wants("motion_rotation") || wants("motion_position") {
+            stage("reading raw matches");
+            let matches = inputs
+                .graph
+                .edges
+                .iter()
+                .map(|e| {
+                    db.matches(
+                        inputs.graph.image_ids[e.i as usize],
+                        inputs.graph.image_ids[e.j as usize],
+                    )
+                })
+                .collect::<Result<Vec<_>>>()?;
+            stage("searching for multiple motions");
+            values.extend(multiple_motions::compute(inputs, &geometry, &matches)?);
+        }
+    }
+    Ok(PairPriors {
+        values,
+        focal_estimates,
+    })
+}
+
+/// Cameras (with focal lengths estimated where only guessed) and every edge's relative pose.
+fn relative_poses(
+    db: &Database,
+    inputs: &Inputs,
+    camera_ids: &[u32],
+    stage: &dyn Fn(&str),
+) -> Result<(ViewGeometry, Vec<FocalEstimate>)> {
+    let mut models: Vec<CameraModel> = Vec::new();
+    let mut index: HashMap<u32, usize> = HashMap::new();
+    for c in db.cameras()? {
+        if camera_ids.contains(&c.camera_id) {
+            index.insert(c.camera_id, models.len());
+            models.push(CameraModel::from_colmap(&c)?);
+        }
+    }
+    let camera_of = |v: usize| index[&camera_ids[v]];
+    let stored = db.geometries()?;
+    let by_pair: HashMap<(u32, u32), usize> = stored
+        .iter()
+        .enumerate()
+        .map(|(k, g)| ((g.image_id1, g.image_id2), k))
+        .collect();
+    let geometries: Vec<_> = inputs
+        .graph
+        .edges
+        .iter()
+        .map(|e| {
+            let p = &inputs.pairs[e.pair];
+            by_pair
+                .get(&(p.image_id1, p.image_id2))
+                .map(|&k| &stored[k])
+        })
+        .collect();
+    let mut estimates = Vec::new();
+    if models.iter().any(|m| !m.prior_focal_length) {
+        stage("estimating focal lengths from the fundamental matrices");
+        let pairs: Vec<FundamentalPair> = inputs
+            .graph
+            .edges
+            .iter()
+            .zip(&geometries)
+            .filter_map(|(e, g)| {
+                let f = g.and_then(|g| g.f)?;
+                Some(FundamentalPair {
+                    a: camera_of(e.i as usize),
+                    b: camera_of(e.j as usize),
+                    f: Matrix3::from_row_slice(&f),
+                })
+            })
+            .collect();
+        for (c, f) in focal::estimate(&models, &pairs).into_iter().enumerate() {
+            if let Some(f) = f {
+                estimates.push(FocalEstimate {
+                    camera_id: models[c].camera_id,
+                    guessed: models[c].fx,
+                    estimated: f,
+                });
+                stage(&format!(
+                    "camera {}: focal length {f:.1} px estimated (database guess {:.1})",
+                    models[c].camera_id, models[c].fx
+                ));
+                models[c] = models[c].with_focal(f);
+            }
+        }
+    }
+    stage("recovering relative poses");
+    let cameras = (0..inputs.graph.num_vertices())
+        .map(|v| models[camera_of(v)].clone())
+        .collect();
+    let geometry =
+        view_geometry::compute(inputs, cameras, &geometries).context("computing relative poses")?;
+    Ok((geometry, estimates))
+}

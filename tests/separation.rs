@@ -1,0 +1,87 @@
+//! Separation of true and false pairs on the generated duplicate-structure scene: each pair
+//! prior's AUC against the ground-truth labels, and what `--preset disambiguation` removes.
+//! `cargo test --test separation -- --nocapture` prints the table; the ignored test runs a
+//! bigger scene (`cargo test --release --test separation -- --ignored --nocapture`).
+
+use std::time::Instant;
+use vgsel_colmap::costs::CostModel;
+use vgsel_colmap::database::Database;
+use vgsel_colmap::prune::{plan, Options, Plan};
+use vgsel_colmap::search::{Criteria, FlowRule};
+use vgsel_colmap::separation::{measure, Separation};
+use vgsel_colmap::synth::{generate, GroundTruth, Layout, SceneSpec};
+
+/// The disambiguation preset plus the general preset's pair priors at weight 0, so that one run
+/// measures every pair prior.
+fn all_priors() -> CostModel {
+    let mut model = CostModel::disambiguation();
+    for mut p in CostModel::general().pair_priors {
+        p.weight = 0.0;
+        model.pair_priors.push(p);
+    }
+    model
+}
+
+fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("duplicate.db");
+    let t = Instant::now();
+    let gt = generate(spec, &path).unwrap();
+    eprintln!("generated in {:.1} s", t.elapsed().as_secs_f64());
+    let db = Database::open_read_only(&path).unwrap();
+    let options = Options {
+        min_num_matches: 15,
+        rule: FlowRule::Criteria(Criteria {
+            min_image_fraction: 0.8,
+            min_pairs_per_image: 5.0,
+        }),
+        model: all_priors(),
+    };
+    let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();
+    eprintln!("plan: {:?}", p.timings);
+    let s = measure(&p, &gt);
+    eprintln!("{}", s.table());
+    (p, gt, s)
+}
+
+fn duplicate(num_images: usize, num_points: usize, yaw_degrees: f64) -> SceneSpec {
+    SceneSpec {
+        num_images,
+        num_points,
+        layout: Layout::Duplicate {
+            yaw_degrees,
+            overview_images: 4,
+        },
+        seed: 3,
+        ..SceneSpec::default()
+    }
+}
+
+fn auc(s: &Separation, name: &str) -> f64 {
+    s.priors
+        .iter()
+        .find(|p| p.name == name)
+        .unwrap()
+        .auc
+        .unwrap()
+}
+
+#[test]
+fn duplicate_scene_is_separated() {
+    let (_, _, s) = run(&duplicate(36, 5000, 0.0));
+    assert!(s.false_pairs >= 10, "the scene must have false pairs");
+    assert!(auc(&s, "loop_fraction") >= 0.95);
+    assert!(s.cost_auc.unwrap() >= 0.9);
+    assert!(s.false_removed >= 0.9);
+    assert_eq!(s.images_without_pair, 0);
+    assert_eq!(s.true_components, 1);
+}
+
+#[test]
+#[ignore]
+fn bigger_duplicate_scenes() {
+    for yaw in [0.0, 40.0] {
+        eprintln!("== 80 images, 12000 points, yaw {yaw}");
+        run(&duplicate(80, 12000, yaw));
+    }
+}
