@@ -325,7 +325,7 @@ fn build_points(spec: &SceneSpec, rng: &mut ChaCha8Rng) -> Vec<ScenePoint> {
 
 /// World-to-camera rotation of a camera at `centre` looking at `target`, z up in the world,
 /// COLMAP's camera axes (x right, y down, z forward).
-fn look_at(centre: &Vector3<f64>, target: &Vector3<f64>) -> Rotation3<f64> {
+pub(crate) fn look_at(centre: &Vector3<f64>, target: &Vector3<f64>) -> Rotation3<f64> {
     let forward = (target - centre).normalize();
     let right = forward.cross(&Vector3::z()).normalize();
     let down = forward.cross(&right);
