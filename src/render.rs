@@ -17,6 +17,7 @@ use nalgebra::{Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use std::f64::consts::{PI, TAU};
 use std::path::Path;
 
 pub const WIDTH: u32 = 480;
@@ -30,7 +31,7 @@ pub enum SceneKind {
     /// One object (a stack of boxes) in a room, cameras on a closed orbit around it.
     Room,
     /// Two identical objects in the two halves of a long room whose walls differ; each object is
-    /// orbited the same way, and a sideways walk along the room links the two orbits.
+    /// half-orbited the same way, and a sideways walk along the room links the two orbits.
     Duplicate,
 }
 
@@ -172,9 +173,10 @@ impl Scene {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xC0FFEE);
         let mut jitter =
             |s: f64| Vector3::new(rng.gen::<f64>() - 0.5, rng.gen::<f64>() - 0.5, 0.0) * s;
-        let mut orbit = |poses: &mut Vec<(Vector3<f64>, Vector3<f64>)>, x: f64, n: usize| {
+        // n cameras around the object at (x, 0), on angles [from, from + span) (radians).
+        let mut orbit = |poses: &mut Vec<_>, x: f64, n: usize, from: f64, span: f64| {
             for k in 0..n {
-                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                let a = from + span * k as f64 / n as f64;
                 let centre = Vector3::new(x + 2.8 * a.cos(), 2.8 * a.sin(), 1.6) + jitter(0.2);
                 poses.push((centre, Vector3::new(x, 0.0, 0.7) + jitter(0.2)));
             }
@@ -187,7 +189,7 @@ impl Scene {
                 cuboids.extend(object(0.0, 0.0));
                 cuboids.push(Cuboid::new([2.0, 3.0, 0.0], [3.5, 4.0, 1.0], tex()));
                 cuboids.push(Cuboid::new([-4.0, -3.5, 0.0], [-3.0, -2.0, 1.5], tex()));
-                orbit(&mut poses, 0.0, num_images);
+                orbit(&mut poses, 0.0, num_images, 0.0, TAU);
             }
             SceneKind::Duplicate => {
                 // A long room whose halves (x < 0, x > 0) have their own wall textures; the same
@@ -200,8 +202,15 @@ impl Scene {
                 cuboids.extend(object(5.0, 0.0));
                 let walk = (num_images / 4).max(2);
                 let per_orbit = (num_images - walk) / 2;
-                orbit(&mut poses, -5.0, per_orbit);
-                orbit(&mut poses, 5.0, num_images - walk - per_orbit);
+                // Half orbits on the walk's side, so the walk sees what the orbits see.
+                orbit(&mut poses, -5.0, per_orbit, 1.1 * PI, 0.8 * PI);
+                orbit(
+                    &mut poses,
+                    5.0,
+                    num_images - walk - per_orbit,
+                    1.1 * PI,
+                    0.8 * PI,
+                );
                 for k in 0..walk {
                     let x = -6.0 + 12.0 * k as f64 / (walk - 1) as f64;
                     let centre = Vector3::new(x, -3.5, 1.6) + jitter(0.2);
