@@ -37,16 +37,14 @@ fn rendered_duplicate_scene_through_colmap() {
     let (full, pruned) = (&summary["full"], &summary["pruned"]);
     let n = |v: &Value, key: &str| v[key].as_u64().unwrap_or_else(|| panic!("{key} in {v}"));
     assert_eq!(n(full, "images_total"), 20);
-    // The prune keeps fewer pairs, drops no true connectivity, and removes false pairs first.
+    // The prune keeps fewer pairs, and the true pairs left still connect every image.
     let pairs = &pruned["pairs"];
     assert!(n(pruned, "pairs_used") < n(full, "pairs_used"));
+    assert_eq!(n(&pairs["baseline"], "used"), n(full, "pairs_used"));
+    assert_eq!(n(pairs, "true_kept"), n(pairs, "true"), "{pairs}");
     assert_eq!(n(pairs, "true_graph_components"), 1, "{pairs}");
-    assert!(
-        n(pairs, "false_removed") * n(full, "pairs_used")
-            >= n(&full["pairs"], "false") * (n(full, "pairs_used") - n(pruned, "pairs_used")),
-        "the prune removes false pairs at least at their share: {pairs}"
-    );
-    // The pruned model: most images registered and correct.
-    assert!(n(pruned, "registered") >= 14, "{pruned}");
+    // The pruned model (measured: 20 registered, 12 correct; the full model also 20 and 12 —
+    // the rest sit on the other copy of the object: the general preset does not disambiguate).
+    assert!(n(pruned, "registered") >= 16, "{pruned}");
     assert!(n(pruned, "correct") >= 10, "{pruned}");
 }
