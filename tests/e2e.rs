@@ -48,3 +48,37 @@ fn rendered_duplicate_scene_through_colmap() {
     assert!(n(pruned, "registered") >= 16, "{pruned}");
     assert!(n(pruned, "correct") >= 10, "{pruned}");
 }
+
+/// `generate images` writes the PNGs and a COLMAP text model that `eval` reads back as exact.
+#[test]
+fn generate_images_writes_pngs_and_a_ground_truth_eval_accepts() {
+    let dir = tempfile::tempdir().unwrap();
+    let bin = env!("CARGO_BIN_EXE_vgsel-colmap");
+    let run = |args: &[&str]| {
+        let out = Command::new(bin).args(args).output().unwrap();
+        assert!(out.status.success(), "{args:?}: {out:?}");
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let out = dir.path().to_str().unwrap();
+    run(&[
+        "generate",
+        "images",
+        "--scene",
+        "room",
+        "--num_images",
+        "4",
+        "--output",
+        out,
+    ]);
+    let pngs = std::fs::read_dir(dir.path().join("images"))
+        .unwrap()
+        .count();
+    assert_eq!(pngs, 4);
+    let gt = dir.path().join("gt");
+    let gt = gt.to_str().unwrap();
+    let scores: Value =
+        serde_json::from_str(&run(&["eval", "--model", gt, "--ground_truth", gt])).unwrap();
+    assert_eq!(scores["correct"], 4, "{scores}");
+    let counts: Value = serde_json::from_str(&run(&["eval", "--model", gt])).unwrap();
+    assert_eq!(counts, serde_json::json!({"models": 1, "registered": 4}));
+}
