@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Benchmarks vgsel-colmap's flow search against LEMON NetworkSimplex, OR-tools and networkx on the
 # paper's synthetic graphs, all in one run; prints medians and ratios as a markdown table.
-# usage: scripts/bench-solver.sh [--sizes 300x10000,1000x100000,5000x1000000] [--repeats 5]
+# usage: scripts/bench-solver.sh [--sizes 300x10000,1000x100000,5000x1000000] [--repeats 3]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Installs the system packages vgsel-colmap's tests, demo and benchmarks use (Debian/Ubuntu):
-# COLMAP 3.8 (real mapper runs in tests), sqlite3 (inspection in scripts), python3 (the tables
-# of scripts/pipeline.sh).
+# COLMAP 3.8 (real mapper runs in tests), sqlite3 (inspection in scripts), graphviz (the
+# export test renders the DOT file with `dot`) and python3 (the tables of scripts/pipeline.sh).
 # Does nothing for packages already installed; needs root or sudo otherwise.
 set -euo pipefail
-packages=(colmap sqlite3 bc python3)
+packages=(colmap sqlite3 bc graphviz python3)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

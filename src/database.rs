@@ -167,9 +167,16 @@ pub(crate) fn sql_error(path: &Path, err: rusqlite::Error) -> anyhow::Error {
     let shown = path.display();
     match err.sqlite_error_code() {
         Some(ErrorCode::DatabaseBusy) | Some(ErrorCode::DatabaseLocked) => {
-            anyhow!("{shown}: database is locked by another process (close it and retry)")
+            anyhow!("{shown}: database is locked by another process (close it and retry, or wait longer with --lock_timeout)")
         }
         Some(ErrorCode::NotADatabase) => anyhow!("{shown}: file is not a database"),
+        Some(ErrorCode::DatabaseCorrupt) => {
+            anyhow!("{shown}: database file is corrupt or truncated ({err})")
+        }
+        Some(ErrorCode::DiskFull) => anyhow!("{shown}: disk full while writing ({err})"),
+        Some(ErrorCode::SystemIoFailure) => {
+            anyhow!("{shown}: disk I/O error (disk full, over a file size limit, or failing?)")
+        }
         Some(ErrorCode::ReadOnly) => anyhow!("{shown}: database is read-only ({err})"),
         _ => anyhow!("{shown}: SQLite error: {err}"),
     }
@@ -308,13 +315,19 @@ impl Database {
     /// Opens an existing COLMAP database for reading and writing; fails with a one-line reason
     /// when the file is missing, not SQLite, or lacks COLMAP's tables.
     pub fn open(path: &Path) -> Result<Database> {
-        Self::open_with(path, false)
+        Self::open_with_lock_timeout(path, false, BUSY_TIMEOUT)
     }
     pub fn open_read_only(path: &Path) -> Result<Database> {
-        Self::open_with(path, true)
+        Self::open_with_lock_timeout(path, true, BUSY_TIMEOUT)
     }
 
-    fn open_with(path: &Path, read_only: bool) -> Result<Database> {
+    /// [`Database::open`] or [`Database::open_read_only`], waiting up to `lock_timeout` for
+    /// another process's lock in every statement, opening included.
+    pub fn open_with_lock_timeout(
+        path: &Path,
+        read_only: bool,
+        lock_timeout: Duration,
+    ) -> Result<Database> {
         let shown = path.display();
         match std::fs::metadata(path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
@@ -340,7 +353,7 @@ impl Database {
         };
         let conn = Connection::open_with_flags(path, mode | OpenFlags::SQLITE_OPEN_NO_MUTEX)
             .map_err(fail)?;
-        conn.busy_timeout(BUSY_TIMEOUT).map_err(fail)?;
+        conn.busy_timeout(lock_timeout).map_err(fail)?;
         let layout = detect_layout(&conn).map_err(|e| match e.downcast::<rusqlite::Error>() {
             Ok(sqlite) => fail(sqlite),
             Err(other) => anyhow!("cannot open COLMAP database {shown}: {other}"),

@@ -1,14 +1,20 @@
 //! The `vgsel-colmap` command line.
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::database::Database;
+use vgsel_colmap::overrides::{NameList, Overrides};
+use vgsel_colmap::progress::Progress;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
-use vgsel_colmap::{eval, graph_file, pair_truth, prune, render, report::Report, rewrite, synth};
+use vgsel_colmap::{
+    eval, export, graph_file, pair_truth, plots, prune, render,
+    report::{Outputs, Report},
+    rewrite, synth, synthetic_graph,
+};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -19,8 +25,21 @@ Examples:
   # write a pruned copy and a JSON report, leave db.db untouched:
   vgsel-colmap prune --database_path db.db --output pruned.db --report report.json
 
+  # see what was kept: plots, a pair list for `colmap matches_importer`, a Graphviz graph:
+  vgsel-colmap prune --database_path db.db --dry_run --plots plots --pairs_out pairs.txt
+  vgsel-colmap export --database_path db.db --format dot --output graph.dot
+  dot -Tsvg graph.dot > graph.svg
+
+  # always keep some pairs, never use others (lines `name1 name2`; one image name a line):
+  vgsel-colmap prune --database_path db.db --keep_pairs keep.txt \
+      --forbid_pairs bad_pairs.txt --forbid_images bad_images.txt
+
   # put every original pair back:
   vgsel-colmap restore --database_path db.db
+
+  # shell completions and the man page:
+  vgsel-colmap completions bash > /etc/bash_completion.d/vgsel-colmap
+  vgsel-colmap man > vgsel-colmap.1
 
 Exit status: 0 success, 1 error (the database is left unchanged), 2 bad command line.";
 
@@ -34,11 +53,19 @@ struct Cli {
     /// Print nothing on stderr but errors.
     #[arg(short, long, global = true)]
     quiet: bool,
+    /// Print each stage with its time, and details, as plain lines (instead of progress bars).
+    #[arg(short, long, global = true)]
+    verbose: bool,
 }
 
 #[derive(Subcommand)]
 enum Command {
     /// Keep only the selected pairs valid in two_view_geometries (reversible).
+    #[command(after_help = "Examples:
+  vgsel-colmap prune --database_path db.db --report report.json --plots plots
+  vgsel-colmap prune --database_path db.db --dry_run -v --min_pairs_per_image 10
+  vgsel-colmap prune --database_path db.db --output pruned.db --pairs_out pairs.txt \\
+      --keep_pairs keep.txt --forbid_images bad_images.txt")]
     Prune(PruneArgs),
     /// Put back every pair a prune invalidated, byte for byte, and drop vgsel-colmap's tables.
     Restore(DatabaseArg),
@@ -51,6 +78,31 @@ enum Command {
     /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
     #[command(subcommand)]
     Generate(GenerateCommand),
+    /// Write the view graph with each pair's priors, cost and kept/removed, for Graphviz or networkx.
+    #[command(after_help = "Examples:
+  vgsel-colmap export --database_path db.db --format dot --output graph.dot
+  dot -Tsvg graph.dot > graph.svg
+  vgsel-colmap export --database_path db.db --format graphml --output graph.graphml
+  python3 -c \"import networkx; print(networkx.read_graphml('graph.graphml'))\"")]
+    Export(ExportArgs),
+    /// Print a shell completion script.
+    Completions {
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff).
+    Man,
+}
+
+#[derive(Args)]
+struct ExportArgs {
+    #[command(flatten)]
+    database: DatabaseArg,
+    #[arg(long, value_enum)]
+    format: export::Format,
+    /// The file to write.
+    #[arg(long, value_name = "FILE")]
+    output: PathBuf,
 }
 
 #[derive(Args)]
@@ -90,8 +142,32 @@ struct EvalArgs {
 enum GenerateCommand {
     /// A matched COLMAP 3.8 database of cameras orbiting a synthetic scene, with its ground truth.
     Database(GenerateDatabaseArgs),
+    /// A synthetic view graph of the paper's supplement in the `solve` text format.
+    Graph(GenerateGraphArgs),
     /// Rendered PNG images of a textured scene (DIR/images) with ground-truth poses (DIR/gt).
     Images(GenerateImagesArgs),
+}
+
+#[derive(Args)]
+struct GenerateGraphArgs {
+    /// The graph file to write.
+    #[arg(long, value_name = "FILE")]
+    output: PathBuf,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
+    images: u64,
+    #[arg(long)]
+    pairs: u64,
+    /// Images along a line (a facade) or a closed loop (around a building).
+    #[arg(long, value_enum, default_value = "loop")]
+    arrangement: GraphArrangement,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum GraphArrangement {
+    Linear,
+    Loop,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -143,6 +219,13 @@ struct GenerateDatabaseArgs {
         default_value_t = 6000
     )]
     num_points: usize,
+    /// Half-angle of the cone a point is seen from: narrower means fewer pairs per image.
+    #[arg(
+        long = "view_cone_degrees",
+        visible_alias = "view-cone-degrees",
+        default_value_t = 55.0
+    )]
+    view_cone_degrees: f64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
 }
@@ -156,6 +239,17 @@ struct DatabaseArg {
         value_name = "DB"
     )]
     database_path: PathBuf,
+    /// Seconds to wait for another process's lock on DB (COLMAP GUI, a running matcher) before
+    /// giving up with an error.
+    #[arg(long = "lock_timeout", visible_alias = "lock-timeout", value_name = "SECONDS", default_value_t = 5.0, value_parser = lock_seconds)]
+    lock_timeout: f64,
+}
+
+impl DatabaseArg {
+    fn open(&self, read_only: bool) -> Result<Database> {
+        let timeout = Duration::from_secs_f64(self.lock_timeout);
+        Database::open_with_lock_timeout(&self.database_path, read_only, timeout)
+    }
 }
 
 #[derive(Args)]
@@ -230,9 +324,47 @@ struct PruneArgs {
     /// Which priors make the costs.
     #[arg(long, value_enum, default_value = "general")]
     preset: Preset,
-    /// Write a JSON report here.
+    /// Write a JSON report here (schema: docs/report.md).
     #[arg(long, value_name = "FILE")]
     report: Option<PathBuf>,
+    /// Write selection_curve.svg and match_matrix.svg into this directory.
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
+    /// Write the kept pairs as `name1 name2` lines (colmap matches_importer --match_type pairs).
+    #[arg(long = "pairs_out", visible_alias = "pairs-out", value_name = "FILE")]
+    pairs_out: Option<PathBuf>,
+    /// Always keep these pairs (lines `name1 name2`).
+    #[arg(long = "keep_pairs", visible_alias = "keep-pairs", value_name = "FILE")]
+    keep_pairs: Option<PathBuf>,
+    /// Never select these pairs (lines `name1 name2`).
+    #[arg(
+        long = "forbid_pairs",
+        visible_alias = "forbid-pairs",
+        value_name = "FILE"
+    )]
+    forbid_pairs: Option<PathBuf>,
+    /// Never select these images nor any of their pairs (one name a line).
+    #[arg(
+        long = "forbid_images",
+        visible_alias = "forbid-images",
+        value_name = "FILE"
+    )]
+    forbid_images: Option<PathBuf>,
+}
+
+impl PruneArgs {
+    fn overrides(&self) -> Result<Overrides> {
+        let read = |path: &Option<PathBuf>, pairs| {
+            path.as_deref()
+                .map(|p| NameList::read(p, pairs))
+                .transpose()
+        };
+        Ok(Overrides {
+            keep_pairs: read(&self.keep_pairs, true)?,
+            forbid_pairs: read(&self.forbid_pairs, true)?,
+            forbid_images: read(&self.forbid_images, false)?,
+        })
+    }
 }
 
 #[derive(Args)]
@@ -258,11 +390,20 @@ fn non_negative(s: &str) -> Result<f64, String> {
     }
 }
 
+/// SQLite keeps its busy timeout in milliseconds as a C int, so a week is a safe upper bound.
+fn lock_seconds(s: &str) -> Result<f64, String> {
+    match non_negative(s) {
+        Ok(x) if x <= 604_800.0 => Ok(x),
+        _ => Err(format!("`{s}` is not a number of seconds in [0, 604800]")),
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let quiet = cli.quiet;
+    let progress = Progress::new(quiet, cli.verbose);
     let result = match cli.command {
-        Command::Prune(args) => run_prune(&args, quiet),
+        Command::Prune(args) => run_prune(&args, quiet, &progress),
         Command::Restore(args) => run_restore(&args, quiet),
         Command::Inspect(args) => run_inspect(&args),
         Command::Solve(args) => run_solve(&args),
@@ -276,7 +417,22 @@ fn main() -> ExitCode {
             render::Scene::build(kind, args.num_images, args.seed)
                 .and_then(|scene| scene.write(&args.output))
         }
+        Command::Generate(GenerateCommand::Graph(args)) => run_generate_graph(&args),
+        Command::Export(args) => run_export(&args, quiet, &progress),
+        Command::Completions { shell } => {
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "vgsel-colmap", &mut script);
+            print_bytes(&script, "the completion script")
+        }
+        Command::Man => {
+            let mut page = Vec::new();
+            clap_mangen::Man::new(Cli::command())
+                .render(&mut page)
+                .map_err(anyhow::Error::from)
+                .and_then(|()| print_bytes(&page, "the man page"))
+        }
     };
+    progress.finish();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -289,7 +445,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
+fn run_prune(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     let input = &args.database.database_path;
     if let Some(out) = &args.output {
         if out.exists() && !args.overwrite {
@@ -305,12 +461,19 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
             );
         }
     }
+    if let Some(report) = &args.report {
+        // Checked before the database is written, so a bad path cannot fail the command after
+        // the prune took effect.
+        let parent = report.parent().filter(|p| !p.as_os_str().is_empty());
+        if report.is_dir() || parent.is_some_and(|p| !p.is_dir()) {
+            bail!(
+                "cannot write report {}: not a file in an existing directory",
+                report.display()
+            );
+        }
+    }
     let in_place = args.output.is_none() && !args.dry_run;
-    let mut db = if in_place {
-        Database::open(input)?
-    } else {
-        Database::open_read_only(input)?
-    };
+    let mut db = args.database.open(!in_place)?;
     let options = prune::Options {
         min_num_matches: args.min_num_matches,
         rule: args.flow.rule(),
@@ -318,12 +481,18 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
             Preset::General => CostModel::general(),
         },
     };
-    let stage = |s: &str| {
-        if !quiet {
-            eprintln!("vgsel-colmap: {s}");
-        }
-    };
-    let mut plan = prune::plan(&db, &options, &stage)?;
+    let stage = |s: &str| progress.stage(s);
+    let overrides = args.overrides()?;
+    let mut plan = prune::plan_with(&db, &options, &overrides, &stage)?;
+    progress.detail(&format!(
+        "view graph: {} images, {} pairs; network: {} images, {} pairs; flow F = {}",
+        plan.graph.num_vertices(),
+        plan.graph.edges.len(),
+        plan.network.problem.image_costs.len(),
+        plan.network.problem.pairs.len(),
+        plan.search.selection.flow
+    ));
+    let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     let parameters = serde_json::json!({
         "preset": "general",
         "min_num_matches": args.min_num_matches,
@@ -331,7 +500,21 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
         "min_image_fraction": args.flow.min_image_fraction,
         "min_pairs_per_image": args.flow.min_pairs_per_image,
         "cost_model": options.model,
+        "keep_pairs": path_text(&args.keep_pairs),
+        "forbid_pairs": path_text(&args.forbid_pairs),
+        "forbid_images": path_text(&args.forbid_images),
     });
+    // The extra files first: if one cannot be written, the database is still untouched.
+    let mut outputs = Outputs::default();
+    if let Some(path) = &args.pairs_out {
+        std::fs::write(path, export::pairs_list(&plan))
+            .with_context(|| format!("cannot write --pairs_out {}", path.display()))?;
+        outputs.pairs_out = Some(path.display().to_string());
+    }
+    if let Some(dir) = &args.plots {
+        let files = plots::write(&plan, dir, progress)?;
+        outputs.plots = files.iter().map(|f| f.display().to_string()).collect();
+    }
     let written_to = if args.dry_run {
         None
     } else {
@@ -360,7 +543,9 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
         plan.timings.total += plan.timings.write;
         Some(target.display().to_string())
     };
-    let report = Report::new(&plan, input.display().to_string(), written_to, parameters);
+    let mut report = Report::new(&plan, input.display().to_string(), written_to, parameters);
+    report.outputs = outputs;
+    progress.finish();
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report)?;
         std::fs::write(path, json + "\n")
@@ -370,6 +555,14 @@ fn run_prune(args: &PruneArgs, quiet: bool) -> Result<()> {
         eprintln!("{}", report.summary());
     }
     Ok(())
+}
+
+/// Writes generated text to stdout; a closed pipe (`| head`) is an error line, not a panic.
+fn print_bytes(bytes: &[u8], what: &str) -> Result<()> {
+    use std::io::Write;
+    std::io::stdout()
+        .write_all(bytes)
+        .with_context(|| format!("cannot write {what}"))
 }
 
 /// Copies `input` to a temporary file beside `out`, prunes the copy, then renames it to `out`:
@@ -384,7 +577,8 @@ fn write_pruned_copy(
         .file_name()
         .context("--output names no file")?
         .to_string_lossy();
-    let tmp = out.with_file_name(format!(".{name}.vgsel-tmp"));
+    rewrite::remove_stale_temporaries(out);
+    let tmp = out.with_file_name(format!(".{name}.vgsel-tmp-{}", std::process::id()));
     let result = (|| {
         rewrite::copy_database(input, &tmp, true)?;
         let mut copy = Database::open(&tmp)?;
@@ -392,9 +586,15 @@ fn write_pruned_copy(
         drop(copy);
         std::fs::rename(&tmp, out)
             .with_context(|| format!("cannot move the pruned copy to {}", out.display()))
-    })();
+    })()
+    .with_context(|| format!("cannot write --output {}", out.display()));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
+        let journal = format!(
+            "{}-journal",
+            tmp.file_name().unwrap_or_default().to_string_lossy()
+        );
+        let _ = std::fs::remove_file(tmp.with_file_name(journal));
     }
     result
 }
@@ -404,7 +604,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 fn run_restore(args: &DatabaseArg, quiet: bool) -> Result<()> {
-    let mut db = Database::open(&args.database_path)?;
+    let mut db = args.open(false)?;
     let restored = rewrite::restore(&mut db)?;
     if !quiet {
         eprintln!(
@@ -416,7 +616,7 @@ fn run_restore(args: &DatabaseArg, quiet: bool) -> Result<()> {
 }
 
 fn run_inspect(args: &InspectArgs) -> Result<()> {
-    let db = Database::open_read_only(&args.database.database_path)?;
+    let db = args.database.open(true)?;
     let images = db.images()?;
     let pairs = db.verified_pairs()?;
     let graph = vgsel_colmap::view_graph::ViewGraph::build(&images, &pairs, args.min_num_matches);
@@ -465,6 +665,25 @@ fn run_inspect(args: &InspectArgs) -> Result<()> {
     Ok(())
 }
 
+fn run_export(args: &ExportArgs, quiet: bool, progress: &Progress) -> Result<()> {
+    let db = Database::open_read_only(&args.database.database_path)?;
+    progress.stage("computing priors and costs");
+    let (text, counts) = export::export(&db, args.format)?;
+    std::fs::write(&args.output, text)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    progress.finish();
+    if !quiet {
+        eprintln!(
+            "vgsel-colmap: wrote {} images and {} pairs ({} kept) to {}",
+            counts.images,
+            counts.pairs,
+            counts.pairs_kept,
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
 fn run_solve(args: &SolveArgs) -> Result<()> {
     let text = std::fs::read_to_string(&args.graph)
         .with_context(|| format!("cannot read graph {}", args.graph.display()))?;
@@ -491,6 +710,7 @@ fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
     let spec = synth::SceneSpec {
         num_images: args.num_images,
         num_points: args.num_points,
+        view_cone_degrees: args.view_cone_degrees,
         seed: args.seed,
         ..Default::default()
     };
@@ -525,4 +745,21 @@ fn run_eval(args: &EvalArgs) -> Result<()> {
     }
     println!("{}", serde_json::to_string_pretty(&value)?);
     Ok(())
+}
+
+fn run_generate_graph(args: &GenerateGraphArgs) -> Result<()> {
+    let (n, e) = (args.images, args.pairs);
+    if e > n * (n - 1) / 2 {
+        bail!(
+            "--pairs {e} do not fit {n} images (at most {})",
+            n * (n - 1) / 2
+        );
+    }
+    let arrangement = match args.arrangement {
+        GraphArrangement::Linear => synthetic_graph::Arrangement::Linear,
+        GraphArrangement::Loop => synthetic_graph::Arrangement::Loop,
+    };
+    let problem = synthetic_graph::generate(n as usize, e as usize, arrangement, args.seed);
+    std::fs::write(&args.output, graph_file::write(&problem))
+        .with_context(|| format!("cannot write graph {}", args.output.display()))
 }

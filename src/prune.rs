@@ -3,8 +3,8 @@
 
 use crate::costs::{self, CostModel, Costs};
 use crate::database::{pair_id, Database, Image, VerifiedPair};
-use crate::network::{PairArc, SelectionProblem};
-use crate::priors::{self, Inputs};
+use crate::overrides::{Listed, Network, Overrides};
+use crate::priors::{self, Inputs, PriorValues};
 use crate::search::{self, FlowRule, SearchResult};
 use crate::view_graph::ViewGraph;
 use anyhow::{bail, Context, Result};
@@ -33,7 +33,14 @@ pub struct Plan {
     pub images: Vec<Image>,
     pub pairs: Vec<VerifiedPair>,
     pub graph: ViewGraph,
+    /// Raw prior values, indexed like the graph's vertices (image priors) or edges (pair priors).
+    pub image_priors: Vec<PriorValues>,
+    pub pair_priors: Vec<PriorValues>,
     pub costs: Costs,
+    /// The network the flow ran on (the view graph less the overrides' arcs).
+    pub network: Network,
+    pub overrides: Listed,
+    /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
     /// pair_ids of the view-graph edges the selection leaves out.
     pub invalidate: Vec<u64>,
@@ -55,6 +62,16 @@ impl Plan {
 
 /// Reads the database and decides the selection. `stage` is told the name of each long step.
 pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Plan> {
+    plan_with(db, options, &Overrides::default(), stage)
+}
+
+/// [`plan`] honouring user overrides (see [`crate::overrides`]).
+pub fn plan_with(
+    db: &Database,
+    options: &Options,
+    overrides: &Overrides,
+    stage: &dyn Fn(&str),
+) -> Result<Plan> {
     let started = Instant::now();
     let mut timings = Timings::default();
 
@@ -76,6 +93,7 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
             options.min_num_matches
         );
     }
+    let resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
     let camera_of: HashMap<u32, u32> = images
         .iter()
         .map(|im| (im.image_id, im.camera_id))
@@ -114,20 +132,9 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
 
     stage("solving the min-cost flow selection");
     let t = Instant::now();
-    let problem = SelectionProblem {
-        image_costs: costs.image_costs.clone(),
-        pairs: graph
-            .edges
-            .iter()
-            .zip(&costs.pair_costs)
-            .map(|(e, &cost)| PairArc {
-                i: e.i,
-                j: e.j,
-                cost,
-            })
-            .collect(),
-    };
-    let search = search::search(&problem, &options.rule);
+    let network = Network::new(&graph, &costs, &resolved);
+    let mut search = search::search(&network.problem, &options.rule);
+    search.selection = network.expand(&graph, &search.selection);
     timings.solve = t.elapsed().as_secs_f64();
 
     let invalidate = graph
@@ -142,7 +149,11 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
         images,
         pairs,
         graph,
+        image_priors,
+        pair_priors,
         costs,
+        network,
+        overrides: resolved.listed,
         search,
         invalidate,
         timings,

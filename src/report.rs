@@ -1,5 +1,6 @@
 //! What a prune did: the JSON report (`--report FILE`) and the short summary on stderr.
 
+use crate::overrides::Listed;
 use crate::prune::{Plan, Timings};
 use crate::search::CriterionStatus;
 use crate::view_graph::{GraphStats, ViewGraph};
@@ -34,9 +35,20 @@ pub struct Report {
     pub pairs_invalidated: usize,
     pub graph_before: GraphStats,
     pub graph_after: GraphStats,
+    /// Of the flow's selection, before kept pairs are added (see docs/report.md).
     pub criteria: Vec<CriterionStatus>,
     pub priors: Vec<PriorSummary>,
+    pub overrides: Listed,
+    /// Files written besides the database: filled in by the command as it writes them.
+    pub outputs: Outputs,
     pub timings: Timings,
+}
+
+/// Paths of the extra files a prune wrote (null or empty when not asked for).
+#[derive(Debug, Default, Serialize)]
+pub struct Outputs {
+    pub pairs_out: Option<String>,
+    pub plots: Vec<String>,
 }
 
 /// Spread of one prior's fitness over all images or pairs, and over the selected ones.
@@ -46,6 +58,8 @@ pub struct PriorSummary {
     pub applies_to: &'static str,
     pub mean_fitness: f64,
     pub mean_fitness_selected: f64,
+    /// Over the images or pairs the selection left out (0 when none).
+    pub mean_fitness_removed: f64,
 }
 
 impl Report {
@@ -70,19 +84,23 @@ impl Report {
             .collect();
         isolated.sort();
         let summarise = |fitness: &[crate::priors::PriorValues], kept: &[bool], applies_to| {
+            let mean_where = |values: &[f64], want: bool| {
+                mean(
+                    values
+                        .iter()
+                        .zip(kept)
+                        .filter(|(_, &k)| k == want)
+                        .map(|(&v, _)| v),
+                )
+            };
             fitness
                 .iter()
                 .map(|f| PriorSummary {
                     name: f.name,
                     applies_to,
                     mean_fitness: mean(f.values.iter().copied()),
-                    mean_fitness_selected: mean(
-                        f.values
-                            .iter()
-                            .zip(kept)
-                            .filter(|(_, &k)| k)
-                            .map(|(&v, _)| v),
-                    ),
+                    mean_fitness_selected: mean_where(&f.values, true),
+                    mean_fitness_removed: mean_where(&f.values, false),
                 })
                 .collect::<Vec<_>>()
         };
@@ -113,6 +131,8 @@ impl Report {
             graph_after: after.stats(),
             criteria: plan.search.criteria.clone(),
             priors,
+            overrides: plan.overrides.clone(),
+            outputs: Outputs::default(),
             timings: plan.timings.clone(),
         }
     }
@@ -156,6 +176,15 @@ impl Report {
                 ""
             }
         );
+        let o = &self.overrides;
+        if !(o.keep_pairs.is_empty() && o.forbid_pairs.is_empty() && o.forbid_images.is_empty()) {
+            s += &format!(
+                "\noverrides: {} pairs kept, {} pairs and {} images forbidden",
+                o.keep_pairs.len(),
+                o.forbid_pairs.len(),
+                o.forbid_images.len()
+            );
+        }
         if !self.images_isolated.is_empty() {
             s += &format!(
                 "\n{} images have no verified pair and were left alone",

@@ -85,6 +85,25 @@ fn ensure_writable(db: &Database) -> Result<()> {
 /// a run record; all in one transaction.
 pub fn apply(db: &mut Database, invalidate: &[u64], run: &RunRecord) -> Result<()> {
     ensure_writable(db)?;
+    let result = apply_in_transaction(db, invalidate, run);
+    if result.is_err() {
+        settle_after_failure(db);
+    }
+    result
+}
+
+/// After a write fails (disk full, I/O error) SQLite can leave the rolled-back transaction's hot
+/// journal beside the database until the next statement. One read plays it back now, so a failed
+/// command leaves no `-journal` file behind; if that read fails too, the next open does it.
+fn settle_after_failure(db: &Database) {
+    let _ = db
+        .conn()
+        .query_row("SELECT count(*) FROM sqlite_master", [], |r| {
+            r.get::<_, i64>(0)
+        });
+}
+
+fn apply_in_transaction(db: &mut Database, invalidate: &[u64], run: &RunRecord) -> Result<()> {
     let path = db.path().to_path_buf();
     let p = path.as_path();
     let columns = db.layout().two_view_columns.clone();
@@ -161,6 +180,14 @@ pub fn restore(db: &mut Database) -> Result<usize> {
         bail!("database was not pruned by vgsel-colmap");
     }
     ensure_writable(db)?;
+    let result = restore_in_transaction(db);
+    if result.is_err() {
+        settle_after_failure(db);
+    }
+    result
+}
+
+fn restore_in_transaction(db: &mut Database) -> Result<usize> {
     let path = db.path().to_path_buf();
     let p = path.as_path();
     let columns = db.layout().two_view_columns.clone();
@@ -210,6 +237,37 @@ pub fn last_run(db: &Database) -> Result<Option<RunRecordRow>> {
 /// Copies a COLMAP database for `prune --output`: SQLite's online backup API into a temporary
 /// file beside `dst`, then a rename, so `dst` is never half-written and a concurrent writer to
 /// `src` cannot tear the copy. Refuses an existing `dst` unless `overwrite`; never modifies `src`.
+/// Removes temporary copies of `dst` (and their journals) that a killed vgsel-colmap left beside
+/// it: names `.NAME.vgsel-tmp-PID…` or `..NAME.vgsel-tmp-PID…` whose process no longer runs.
+/// A SIGKILL cannot be cleaned up after at the time, so the next run does it.
+pub fn remove_stale_temporaries(dst: &Path) {
+    let (Some(dir), Some(name)) = (dst.parent(), dst.file_name()) else {
+        return;
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let prefix = format!(".{}.vgsel-tmp-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = file
+            .strip_prefix(&prefix)
+            .or_else(|| file.strip_prefix(&format!(".{prefix}")))
+        else {
+            continue;
+        };
+        let pid: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        if !pid.is_empty() && !Path::new("/proc").join(&pid).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
 pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
     // Validates src as a COLMAP database (with the usual one-line errors) and opens it read-only.
     let source = Database::open_read_only(src)?;

@@ -3,30 +3,10 @@
 
 mod common;
 
-use common::{dump, schema, table_names, user_version};
+use common::{dump, ok, scene, schema, table_names, user_version, vgsel};
 use rusqlite::types::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use tempfile::TempDir;
+use std::path::Path;
 use vgsel_colmap::database::image_ids;
-use vgsel_colmap::synth::{generate, SceneSpec};
-
-fn vgsel(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
-        .args(args)
-        .output()
-        .expect("running vgsel-colmap")
-}
-
-fn ok(args: &[&str]) -> Output {
-    let out = vgsel(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
 
 /// Fails with exit status 1 and one error line on stderr, the last (progress lines may precede
 /// it); returns that line.
@@ -42,22 +22,6 @@ fn fails(args: &[&str]) -> String {
         "{err}"
     );
     errors[0].to_string()
-}
-
-fn scene() -> (TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    let db = dir.path().join("scene.db");
-    generate(
-        &SceneSpec {
-            num_images: 16,
-            num_points: 3000,
-            seed: 3,
-            ..Default::default()
-        },
-        &db,
-    )
-    .unwrap();
-    (dir, db)
 }
 
 fn s(p: &Path) -> &str {
@@ -277,38 +241,18 @@ fn bad_input_fails_with_one_line_and_changes_nothing() {
     assert_eq!(std::fs::read(&db).unwrap(), bytes);
 
     // Command-line mistakes are usage errors (status 2).
+    let usage = |extra: &[&str]| {
+        let mut args = vec!["prune", "--database_path", s(&db)];
+        args.extend_from_slice(extra);
+        vgsel(&args).status.code()
+    };
+    assert_eq!(usage(&["--flow", "0"]), Some(2));
+    assert_eq!(usage(&["--min_image_fraction", "1.5"]), Some(2));
     assert_eq!(
-        vgsel(&["prune", "--database_path", s(&db), "--flow", "0"])
-            .status
-            .code(),
+        usage(&["--flow", "3", "--min_image_fraction", "0.5"]),
         Some(2)
     );
-    assert_eq!(
-        vgsel(&[
-            "prune",
-            "--database_path",
-            s(&db),
-            "--min_image_fraction",
-            "1.5"
-        ])
-        .status
-        .code(),
-        Some(2)
-    );
-    assert_eq!(
-        vgsel(&[
-            "prune",
-            "--database_path",
-            s(&db),
-            "--flow",
-            "3",
-            "--min_image_fraction",
-            "0.5"
-        ])
-        .status
-        .code(),
-        Some(2)
-    );
+    assert_eq!(std::fs::read(&db).unwrap(), bytes);
 }
 
 #[test]
@@ -354,4 +298,35 @@ fn solve_on_the_triangle_fixture() {
     std::fs::write(bad.path(), "2 1\n-0.5\n-0.5\n1 0 -0.5\n").unwrap();
     let message = fails(&["solve", "--graph", s(bad.path())]);
     assert!(message.contains("line 4"), "{message}");
+}
+
+#[test]
+fn output_removes_what_a_killed_run_left_and_keeps_a_live_runs_files() {
+    let (dir, db) = scene();
+    let out = dir.path().join("out.db");
+    // PIDs above the kernel's limit (4194304) never run; our own PID does.
+    let dead = [
+        ".out.db.vgsel-tmp-999999999",
+        "..out.db.vgsel-tmp-999999999.vgsel-tmp-999999999-journal",
+    ];
+    let live = format!(".out.db.vgsel-tmp-{}", std::process::id());
+    for name in dead.iter().copied().chain([live.as_str()]) {
+        std::fs::write(dir.path().join(name), b"left over").unwrap();
+    }
+    ok(&[
+        "prune",
+        "--database_path",
+        s(&db),
+        "--output",
+        s(&out),
+        "-q",
+    ]);
+    for name in dead {
+        assert!(!dir.path().join(name).exists(), "{name} left behind");
+    }
+    assert!(
+        dir.path().join(&live).exists(),
+        "a running process's file was removed"
+    );
+    assert!(out.exists());
 }

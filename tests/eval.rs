@@ -31,7 +31,7 @@ fn transformed(gt: &GroundTruth, keep: impl Fn(usize) -> bool) -> GroundTruth {
         .filter(|(k, _)| keep(*k))
         .map(|(_, im)| {
             let mut im = im.clone();
-            im.rotation = im.rotation * r.inverse();
+            im.rotation *= r.inverse();
             im.centre = s * (r * im.centre) + t;
             im.translation = -(im.rotation * im.centre);
             im

@@ -278,3 +278,39 @@ pub fn table_names(path: &Path) -> Vec<String> {
         .map(|s| s.1)
         .collect()
 }
+
+/// Runs the built vgsel-colmap binary.
+pub fn vgsel(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .args(args)
+        .output()
+        .expect("running vgsel-colmap")
+}
+
+/// Runs vgsel-colmap and fails the test unless it succeeds.
+pub fn ok(args: &[&str]) -> std::process::Output {
+    let out = vgsel(args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// A generated 16-image matched database in a fresh temporary directory.
+pub fn scene() -> (TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("scene.db");
+    vgsel_colmap::synth::generate(
+        &vgsel_colmap::synth::SceneSpec {
+            num_images: 16,
+            num_points: 3000,
+            seed: 3,
+            ..Default::default()
+        },
+        &db,
+    )
+    .unwrap();
+    (dir, db)
+}
