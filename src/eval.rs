@@ -89,3 +89,23 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
         images,
     })
 }
+
+/// What a model says without ground truth: its number of sub-models and of distinct images.
+#[derive(Clone, Debug, Serialize)]
+pub struct Registered {
+    pub models: usize,
+    pub registered: usize,
+}
+
+/// Counts the sub-models under `sparse` and the distinct image names they register.
+pub fn registered(sparse: &Path) -> Result<Registered> {
+    let dirs = model::model_dirs(sparse)?;
+    let mut names = std::collections::HashSet::new();
+    for dir in &dirs {
+        names.extend(model::read_images(dir)?.into_iter().map(|im| im.name));
+    }
+    Ok(Registered {
+        models: dirs.len(),
+        registered: names.len(),
+    })
+}

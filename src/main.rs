@@ -11,7 +11,7 @@ use vgsel_colmap::overrides::{NameList, Overrides};
 use vgsel_colmap::progress::Progress;
 use vgsel_colmap::search::{self, Criteria, FlowRule};
 use vgsel_colmap::{
-    eval, export, graph_file, plots, prune,
+    eval, export, graph_file, pair_truth, plots, prune, render,
     report::{Outputs, Report},
     rewrite, scores, synth, synthetic_graph,
 };
@@ -110,13 +110,32 @@ struct EvalArgs {
     /// A COLMAP model folder (binary or text), or a folder of sub-models (mapper's output_path).
     #[arg(long, value_name = "DIR")]
     model: PathBuf,
-    /// The ground-truth model (COLMAP text or binary); images are matched by name.
+    /// The ground-truth model (COLMAP text or binary); images are matched by name. Without it
+    /// only models and registered images are reported.
     #[arg(
         long = "ground_truth",
         visible_alias = "ground-truth",
         value_name = "DIR"
     )]
-    ground_truth: PathBuf,
+    ground_truth: Option<PathBuf>,
+    /// The database the model was made from: reports the pairs the mapper used and, with a
+    /// (text) ground truth, labels them true or false by their epipolar error.
+    #[arg(
+        long = "database_path",
+        visible_alias = "database-path",
+        value_name = "DB"
+    )]
+    database_path: Option<PathBuf>,
+    /// The database before the prune: adds false pairs removed and true pairs kept.
+    #[arg(long, value_name = "ORIGINAL.db", requires = "database_path")]
+    baseline: Option<PathBuf>,
+    /// A pair is used by the mapper with at least this many inliers (--Mapper.min_num_matches).
+    #[arg(
+        long = "min_num_matches",
+        visible_alias = "min-num-matches",
+        default_value_t = 15
+    )]
+    min_num_matches: usize,
 }
 
 #[derive(Subcommand)]
@@ -125,6 +144,8 @@ enum GenerateCommand {
     Database(GenerateDatabaseArgs),
     /// A synthetic view graph of the paper's supplement in the `solve` text format.
     Graph(GenerateGraphArgs),
+    /// Rendered PNG images of a textured scene (DIR/images) with ground-truth poses (DIR/gt).
+    Images(GenerateImagesArgs),
 }
 
 #[derive(Args)]
@@ -147,6 +168,31 @@ struct GenerateGraphArgs {
 enum GraphArrangement {
     Linear,
     Loop,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SceneArg {
+    /// One object in a room, cameras orbiting it.
+    Room,
+    /// Two identical objects in differently textured halves of a room, linked by a walk.
+    Duplicate,
+}
+
+#[derive(Args)]
+struct GenerateImagesArgs {
+    #[arg(long, value_enum, default_value = "room")]
+    scene: SceneArg,
+    /// Output folder (images/ and gt/ are created in it).
+    #[arg(long, value_name = "DIR")]
+    output: PathBuf,
+    #[arg(
+        long = "num_images",
+        visible_alias = "num-images",
+        default_value_t = 20
+    )]
+    num_images: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
 }
 
 #[derive(Args)]
@@ -433,6 +479,14 @@ fn main() -> ExitCode {
         Command::Solve(args) => run_solve(&args),
         Command::Eval(args) => run_eval(&args),
         Command::Generate(GenerateCommand::Database(args)) => run_generate_database(&args),
+        Command::Generate(GenerateCommand::Images(args)) => {
+            let kind = match args.scene {
+                SceneArg::Room => render::SceneKind::Room,
+                SceneArg::Duplicate => render::SceneKind::Duplicate,
+            };
+            render::Scene::build(kind, args.num_images, args.seed)
+                .and_then(|scene| scene.write(&args.output))
+        }
         Command::Generate(GenerateCommand::Graph(args)) => run_generate_graph(&args),
         Command::Export(args) => run_export(&args, quiet, &progress),
         Command::Completions { shell } => {
@@ -759,8 +813,27 @@ fn run_generate_database(args: &GenerateDatabaseArgs) -> Result<()> {
 }
 
 fn run_eval(args: &EvalArgs) -> Result<()> {
-    let scores = eval::score(&args.model, &args.ground_truth)?;
-    println!("{}", serde_json::to_string_pretty(&scores)?);
+    let mut value = match &args.ground_truth {
+        Some(gt) => serde_json::to_value(eval::score(&args.model, gt)?)?,
+        None => serde_json::to_value(eval::registered(&args.model)?)?,
+    };
+    if let Some(db) = &args.database_path {
+        let images = Database::open_read_only(db)?.images()?.len();
+        let report = match &args.ground_truth {
+            Some(gt) => Some(pair_truth::report(
+                db,
+                gt,
+                args.baseline.as_deref(),
+                args.min_num_matches,
+            )?),
+            None => None,
+        };
+        let used = pair_truth::used_pairs(db, args.min_num_matches)?.len();
+        value["images_total"] = images.into();
+        value["pairs_used"] = used.into();
+        value["pairs"] = serde_json::to_value(report)?;
+    }
+    println!("{}", serde_json::to_string_pretty(&value)?);
     Ok(())
 }
 

@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Images to two reconstructions: COLMAP features and exhaustive matching, a pruned copy of the
+# database by vgsel-colmap, `colmap mapper` on the full and on the pruned database, and (given a
+# ground-truth model) `vgsel-colmap eval` of both. Prints one side-by-side table and writes
+# WORKDIR/summary.json.
+#
+# usage: scripts/pipeline.sh IMAGES WORKDIR [GT]
+#   IMAGES   folder of images (never modified; large images are downscaled by COLMAP for SIFT
+#            through MAX_IMAGE_SIZE, keypoints stay in full-resolution pixels)
+#   WORKDIR  created if missing; a finished step is not redone (delete WORKDIR to start again)
+#   GT       ground-truth COLMAP model (text or binary); images are matched by name
+# environment (defaults in brackets):
+#   PRUNE_ARGS      extra `vgsel-colmap prune` options [--min_image_fraction 1 --min_pairs_per_image 5]
+#   MAX_IMAGE_SIZE  SIFT image size [1024]       MAX_FEATURES  SIFT features per image [2048]
+#   CAMERA_MODEL    [SIMPLE_RADIAL]              CAMERA_PARAMS known intrinsics, e.g. "f,cx,cy" []
+#   SINGLE_CAMERA   one camera for all images [1]
+#   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
+set -euo pipefail
+[ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
+here=$(cd "$(dirname "$0")/.." && pwd)
+images=$(cd "$1" && pwd)
+mkdir -p "$2"
+work=$(cd "$2" && pwd)
+gt=${3:+$(cd "$3" && pwd)}
+prune_args=${PRUNE_ARGS---min_image_fraction 1 --min_pairs_per_image 5}
+bin=${VGSEL:-$here/target/release/vgsel-colmap}
+[ -x "$bin" ] || (cd "$here" && cargo build --release --quiet)
+log() { echo "pipeline: $*" >&2; }
+
+# Seconds taken by a command, its output going to a log file; fails with the log's tail.
+timed() {
+  local logfile=$1
+  shift
+  local start
+  start=$(date +%s.%N)
+  if ! nice "$@" >"$logfile" 2>&1; then
+    tail -n 20 "$logfile" >&2
+    echo "pipeline: failed: $* (log: $logfile)" >&2
+    exit 1
+  fi
+  echo "$(date +%s.%N) - $start" | bc
+}
+
+if [ ! -f "$work/full.db.done" ]; then
+  rm -f "$work/full.db"
+  camera=(--ImageReader.camera_model "${CAMERA_MODEL:-SIMPLE_RADIAL}"
+    --ImageReader.single_camera "${SINGLE_CAMERA:-1}")
+  [ -n "${CAMERA_PARAMS:-}" ] && camera+=(--ImageReader.camera_params "$CAMERA_PARAMS")
+  log "feature_extractor ($(ls "$images" | wc -l) images)"
+  t_extract=$(timed "$work/extract.log" colmap feature_extractor --database_path "$work/full.db" \
+    --image_path "$images" "${camera[@]}" --SiftExtraction.use_gpu 0 \
+    --SiftExtraction.max_image_size "${MAX_IMAGE_SIZE:-1024}" \
+    --SiftExtraction.max_num_features "${MAX_FEATURES:-2048}")
+  log "exhaustive_matcher"
+  t_match=$(timed "$work/match.log" colmap exhaustive_matcher --database_path "$work/full.db" \
+    --SiftMatching.use_gpu 0)
+  echo "$t_extract $t_match" >"$work/full.db.done"
+fi
+read -r t_extract t_match <"$work/full.db.done"
+
+log "prune $prune_args"
+# shellcheck disable=SC2086 # PRUNE_ARGS is a list of options
+"$bin" prune -q --database_path "$work/full.db" --output "$work/pruned.db" --overwrite \
+  --report "$work/prune.json" $prune_args
+
+for variant in full pruned; do
+  sparse=$work/sparse_$variant
+  if [ ! -f "$sparse.seconds" ]; then
+    rm -rf "$sparse"
+    mkdir -p "$sparse"
+    log "mapper on the $variant database"
+    timed "$work/mapper_$variant.log" colmap mapper --database_path "$work/$variant.db" \
+      --image_path "$images" --output_path "$sparse" --Mapper.extract_colors 0 >"$sparse.seconds"
+  fi
+  eval_args=(--model "$sparse" --database_path "$work/$variant.db")
+  [ -n "$gt" ] && eval_args+=(--ground_truth "$gt")
+  [ "$variant" = pruned ] && eval_args+=(--baseline "$work/full.db")
+  "$bin" eval "${eval_args[@]}" >"$work/eval_$variant.json"
+done
+
+python3 - "$work" "$t_extract" "$t_match" <<'EOF'
+import json, sys
+work, t_extract, t_match = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+rows = {}
+for v in ("full", "pruned"):
+    e = json.load(open(f"{work}/eval_{v}.json"))
+    e["mapper_seconds"] = float(open(f"{work}/sparse_{v}.seconds").read())
+    rows[v] = e
+fmt = lambda x, f: "-" if x is None else f % x
+print(f"{'database':<8} {'pairs':>6} {'mapper s':>9} {'models':>6} {'registered':>10} "
+      f"{'correct':>7} {'med. pos':>9} {'med. rot':>9} {'false pairs':>11}")
+for v, e in rows.items():
+    p = e.get("pairs") or {}
+    print(f"{v:<8} {e['pairs_used']:>6} {e['mapper_seconds']:>9.1f} {e['models']:>6} "
+          f"{str(e['registered']) + '/' + str(e['images_total']):>10} "
+          f"{fmt(e.get('correct'), '%d'):>7} {fmt(e.get('median_position_error'), '%.4f'):>9} "
+          f"{fmt(e.get('median_rotation_error_deg'), '%.2f°'):>9} {fmt(p.get('false'), '%d'):>11}")
+summary = {"extract_seconds": t_extract, "match_seconds": t_match,
+           "prune": json.load(open(f"{work}/prune.json")), **rows}
+json.dump(summary, open(f"{work}/summary.json", "w"), indent=1)
+print(f"(position errors are fractions of the ground truth's extent; files: {work})")
+EOF
