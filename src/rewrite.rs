@@ -9,7 +9,7 @@
 
 use crate::database::{image_ids, sql_error, table_exists, Database, SqlResult, TWO_VIEW_COLUMNS};
 use anyhow::{anyhow, bail, Result};
-use rusqlite::{Connection, OpenFlags, TransactionBehavior};
+use rusqlite::{Connection, OpenFlags, Transaction, TransactionBehavior};
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -84,8 +84,30 @@ fn ensure_writable(db: &Database) -> Result<()> {
 /// (a previous prune is undone first), saves their original rows in the backup table and appends
 /// a run record; all in one transaction.
 pub fn apply(db: &mut Database, invalidate: &[u64], run: &RunRecord) -> Result<()> {
+    write_transaction(db, |tx, columns, p| {
+        apply_in(tx, columns, p, invalidate, run)
+    })
+}
+
+/// Runs `body` in one IMMEDIATE transaction of a writable database and commits it; on failure
+/// the transaction rolls back and the journal is settled. `body` gets the layout's
+/// two_view_geometries columns and the path for error messages.
+fn write_transaction<T>(
+    db: &mut Database,
+    body: impl FnOnce(&Transaction, &[&'static str], &Path) -> Result<T>,
+) -> Result<T> {
     ensure_writable(db)?;
-    let result = apply_in_transaction(db, invalidate, run);
+    let path = db.path().to_path_buf();
+    let columns = db.layout().two_view_columns.clone();
+    let result = (|| {
+        let tx = db
+            .conn_mut()
+            .transaction_with_behavior(TransactionBehavior::Immediate)
+            .sql(&path)?;
+        let out = body(&tx, &columns, &path)?;
+        tx.commit().sql(&path)?;
+        Ok(out)
+    })();
     if result.is_err() {
         settle_after_failure(db);
     }
@@ -103,16 +125,15 @@ fn settle_after_failure(db: &Database) {
         });
 }
 
-fn apply_in_transaction(db: &mut Database, invalidate: &[u64], run: &RunRecord) -> Result<()> {
-    let path = db.path().to_path_buf();
-    let p = path.as_path();
-    let columns = db.layout().two_view_columns.clone();
-    let tx = db
-        .conn_mut()
-        .transaction_with_behavior(TransactionBehavior::Immediate)
-        .sql(p)?;
+fn apply_in(
+    tx: &Transaction,
+    columns: &[&'static str],
+    p: &Path,
+    invalidate: &[u64],
+    run: &RunRecord,
+) -> Result<()> {
     tx.execute_batch(VGSEL_SQL).sql(p)?;
-    put_back(&tx, &columns).sql(p)?;
+    put_back(tx, columns).sql(p)?;
     tx.execute("DELETE FROM vgsel_backup", []).sql(p)?;
 
     let copied: Vec<&str> = TWO_VIEW_COLUMNS
@@ -170,7 +191,7 @@ fn apply_in_transaction(db: &mut Database, invalidate: &[u64], run: &RunRecord) 
         ],
     )
     .sql(p)?;
-    tx.commit().sql(p)
+    Ok(())
 }
 
 /// Puts every backed-up row back, byte for byte, and drops the project's tables. Returns the
@@ -179,27 +200,12 @@ pub fn restore(db: &mut Database) -> Result<usize> {
     if !db.has_backup_table()? {
         bail!("database was not pruned by vgsel-colmap");
     }
-    ensure_writable(db)?;
-    let result = restore_in_transaction(db);
-    if result.is_err() {
-        settle_after_failure(db);
-    }
-    result
-}
-
-fn restore_in_transaction(db: &mut Database) -> Result<usize> {
-    let path = db.path().to_path_buf();
-    let p = path.as_path();
-    let columns = db.layout().two_view_columns.clone();
-    let tx = db
-        .conn_mut()
-        .transaction_with_behavior(TransactionBehavior::Immediate)
-        .sql(p)?;
-    let n = put_back(&tx, &columns).sql(p)?;
-    tx.execute_batch("DROP TABLE vgsel_backup; DROP TABLE IF EXISTS vgsel_runs;")
-        .sql(p)?;
-    tx.commit().sql(p)?;
-    Ok(n)
+    write_transaction(db, |tx, columns, p| {
+        let n = put_back(tx, columns).sql(p)?;
+        tx.execute_batch("DROP TABLE vgsel_backup; DROP TABLE IF EXISTS vgsel_runs;")
+            .sql(p)?;
+        Ok(n)
+    })
 }
 
 /// The most recent prune's record, or None when the database has no runs table (never pruned,
