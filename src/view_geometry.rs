@@ -21,6 +21,9 @@ pub struct ViewGeometry {
     pub normalised: Vec<Vec<[f64; 2]>>,
     /// Pose of each edge, vertex `i` to vertex `j`; None where no pose explains the inliers.
     pub poses: Vec<Option<RelativePose>>,
+    /// The homography COLMAP's verification stored for each edge, normalised by the intrinsics
+    /// (K2⁻¹ H K1); None where the database has none.
+    pub homographies: Vec<Option<Matrix3<f64>>>,
 }
 
 impl ViewGeometry {
@@ -71,8 +74,20 @@ pub fn compute(
         cameras,
         normalised,
         poses: Vec::new(),
+        homographies: Vec::new(),
     };
     let m3 = |m: Option<[f64; 9]>| m.map(|a| Matrix3::from_row_slice(&a));
+    geometry.homographies = inputs
+        .graph
+        .edges
+        .iter()
+        .zip(geometries)
+        .map(|(e, stored)| {
+            let h = m3(stored.and_then(|s| s.h))?;
+            let k2_inv = geometry.cameras[e.j as usize].k().try_inverse()?;
+            Some(k2_inv * h * geometry.cameras[e.i as usize].k())
+        })
+        .collect();
     geometry.poses = (0..inputs.graph.edges.len())
         .into_par_iter()
         .map(|edge| {

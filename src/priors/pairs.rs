@@ -63,7 +63,7 @@ pub fn compute(
             values.push(triangulation_angle::compute(inputs, &geometry));
         }
         if wants("homography") {
-            stage("fitting homographies");
+            stage("scoring homographies");
             values.push(homography::compute(inputs, &geometry)?);
         }
         if wants("loop") || wants("loop_fraction") {
