@@ -7,7 +7,8 @@
 # usage: scripts/pipeline.sh IMAGES WORKDIR [GT]
 #   IMAGES   folder of images (never modified; large images are downscaled by COLMAP for SIFT
 #            through MAX_IMAGE_SIZE, keypoints stay in full-resolution pixels)
-#   WORKDIR  created if missing; a finished step is not redone (delete WORKDIR to start again)
+#   WORKDIR  created if missing; features, matches and the full model are not redone when
+#            present (delete WORKDIR to start again); the prune and its mapper always run
 #   GT       ground-truth COLMAP model (text or binary); images are matched by name
 # environment (defaults in brackets):
 #   PRUNE_ARGS      extra `vgsel-colmap prune` options [--min_image_fraction 1 --min_pairs_per_image 5]
@@ -62,6 +63,8 @@ log "prune $prune_args"
 # shellcheck disable=SC2086 # PRUNE_ARGS is a list of options
 "$bin" prune -q --database_path "$work/full.db" --output "$work/pruned.db" --overwrite \
   --report "$work/prune.json" $prune_args
+# The pruned database was just rewritten, so its reconstruction is redone.
+rm -f "$work/sparse_pruned.seconds"
 
 for variant in full pruned; do
   sparse=$work/sparse_$variant
