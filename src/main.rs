@@ -129,6 +129,10 @@ struct EvalArgs {
     /// The database before the prune: adds false pairs removed and true pairs kept.
     #[arg(long, value_name = "ORIGINAL.db", requires = "database_path")]
     baseline: Option<PathBuf>,
+    /// Write every verified pair's ground-truth label (median Sampson error in px, true/false)
+    /// as CSV, keyed by image ids like `prune --scores`, to measure priors against the truth.
+    #[arg(long, value_name = "FILE", requires_all = ["database_path", "ground_truth"])]
+    labels: Option<PathBuf>,
     /// A pair is used by the mapper with at least this many inliers (--Mapper.min_num_matches).
     #[arg(
         long = "min_num_matches",
@@ -832,6 +836,12 @@ fn run_eval(args: &EvalArgs) -> Result<()> {
         value["images_total"] = images.into();
         value["pairs_used"] = used.into();
         value["pairs"] = serde_json::to_value(report)?;
+    }
+    if let (Some(path), Some(db), Some(gt)) =
+        (&args.labels, &args.database_path, &args.ground_truth)
+    {
+        std::fs::write(path, pair_truth::labels_csv(db, gt)?)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     println!("{}", serde_json::to_string_pretty(&value)?);
     Ok(())

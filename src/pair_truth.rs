@@ -150,9 +150,9 @@ pub fn used_pairs(db: &Path, min_num_matches: usize) -> Result<HashSet<u64>> {
     Ok(ids)
 }
 
-/// Labels of the database's verified pairs (as originally verified): true, false, or None when
-/// an image is not in the ground truth; keyed by pair_id.
-fn label_pairs(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<bool>>> {
+/// Median Sampson error in pixels of each of the database's verified pairs (as originally
+/// verified) under the ground truth, or None when an image is not in it; keyed by pair_id.
+fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
     let cameras = read_cameras(gt)?;
     let truth: HashMap<String, model::ModelImage> = model::read_images(gt)?
         .into_iter()
@@ -209,9 +209,35 @@ fn label_pairs(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<bool>>> {
             .get(errors.len() / 2)
             .copied()
             .unwrap_or(f64::INFINITY);
-        labels.insert(pid, Some(median < SAMPSON_THRESHOLD_PX));
+        labels.insert(pid, Some(median));
     }
     Ok(labels)
+}
+
+/// True (epipolar error below [`SAMPSON_THRESHOLD_PX`]), false, or None without ground truth.
+fn label_pairs(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<bool>>> {
+    Ok(pair_errors(db, gt)?
+        .into_iter()
+        .map(|(pid, e)| (pid, e.map(|e| e < SAMPSON_THRESHOLD_PX)))
+        .collect())
+}
+
+/// `eval --labels`: a CSV row per verified pair with ground truth (image ids ascending as in
+/// `--scores`), its median Sampson error and its label, to join with a prune's `--scores`.
+pub fn labels_csv(db_path: &Path, gt: &Path) -> Result<String> {
+    let db = Database::open_read_only(db_path)?;
+    let mut rows: Vec<(u64, f64)> = pair_errors(&db, gt)?
+        .into_iter()
+        .filter_map(|(pid, e)| Some((pid, e?)))
+        .collect();
+    rows.sort_by_key(|r| r.0);
+    let mut out = String::from("image_id1,image_id2,median_sampson_px,true_pair\n");
+    for (pid, e) in rows {
+        let (a, b) = image_ids(pid);
+        let label = (e < SAMPSON_THRESHOLD_PX) as u8;
+        out.push_str(&format!("{a},{b},{e:.3},{label}\n"));
+    }
+    Ok(out)
 }
 
 /// Counts of `used` under `labels`, with the connectivity of the ground-truth images
