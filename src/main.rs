@@ -473,6 +473,13 @@ fn lock_seconds(s: &str) -> Result<f64, String> {
 }
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`| head`) would panic. The default
+    // action ends the process quietly instead; a prune killed so is as safe as any kill (the
+    // database is written in one transaction).
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let quiet = cli.quiet;
     let progress = Progress::new(quiet, cli.verbose);

@@ -315,3 +315,21 @@ fn completions_and_man_page_come_from_the_cli() {
     let help = String::from_utf8(ok(&["--help"]).stdout).unwrap();
     assert!(help.contains("Examples:") && help.contains("--pairs_out"));
 }
+
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    use std::process::Stdio;
+    // `vgsel-colmap completions bash | head -c 0`: nobody reads the pipe, so the first write
+    // meets a closed pipe, which must end the program without a panic message.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .args(["completions", "bash"])
+        .stdout(writer)
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.is_empty(), "{stderr}");
+    assert!(!out.status.success());
+}
