@@ -121,6 +121,10 @@ pub struct CostModel {
     pub pair_priors: Vec<PriorModel>,
     /// Scales image costs relative to pair costs (the authors ran 0, 0.5 and 1).
     pub node_constant: f64,
+    /// Pairs whose fitness (−cost) is below this are left out of the network, never selected.
+    /// Any negative-cost arc lets a flow path run on from one copy of a duplicated structure to
+    /// the other, so without a floor the flow keeps false pairs that rank low (docs/priors.md).
+    pub min_pair_fitness: f64,
 }
 
 impl CostModel {
@@ -136,6 +140,7 @@ impl CostModel {
                 prior("homography", Trapezoid::HOMOGRAPHY, 1.0),
             ],
             node_constant: 1.0,
+            min_pair_fitness: 0.0,
         }
     }
 
@@ -156,10 +161,12 @@ impl CostModel {
                 prior("context_outside", Trapezoid::RISE, 0.0),
                 prior("loop", Trapezoid::RISE, 0.0),
                 prior("loop_fraction", Trapezoid::FRACTION, 1.0),
+                prior("unique_tracks", Trapezoid::FRACTION, 1.0),
                 prior("motion_rotation", Trapezoid::MOTION_ROTATION, 0.5),
                 prior("motion_position", Trapezoid::MOTION_POSITION, 0.5),
             ],
             node_constant: 0.0,
+            min_pair_fitness: 0.6,
         }
     }
 
@@ -356,6 +363,7 @@ mod tests {
                 prior("motion_rotation", Trapezoid::MOTION_ROTATION, 1.0),
             ],
             node_constant: 0.0,
+            min_pair_fitness: 0.0,
         };
         let pairs = [
             PriorValues {

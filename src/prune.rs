@@ -3,7 +3,7 @@
 
 use crate::costs::{self, CostModel, Costs};
 use crate::database::{pair_id, Database, Image, VerifiedPair};
-use crate::overrides::{Listed, Network, Overrides};
+use crate::overrides::{EdgeRule, Listed, Network, Overrides};
 use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, Inputs, PriorValues};
 use crate::search::{self, FlowRule, SearchResult};
@@ -96,7 +96,7 @@ pub fn plan_with(
             options.min_num_matches
         );
     }
-    let resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
+    let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
     let camera_of: HashMap<u32, u32> = images
         .iter()
         .map(|im| (im.image_id, im.camera_id))
@@ -137,6 +137,11 @@ pub fn plan_with(
 
     stage("solving the min-cost flow selection");
     let t = Instant::now();
+    for (rule, cost) in resolved.edges.iter_mut().zip(&costs.pair_costs) {
+        if *rule == EdgeRule::Free && -cost < options.model.min_pair_fitness {
+            *rule = EdgeRule::Forbidden;
+        }
+    }
     let network = Network::new(&graph, &costs, &resolved);
     let mut search = search::search(&network.problem, &options.rule);
     search.selection = network.expand(&graph, &search.selection);

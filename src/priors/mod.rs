@@ -17,6 +17,7 @@ pub mod overlap;
 pub mod pairs;
 pub mod track_fraction;
 pub mod triangulation_angle;
+pub mod unique_tracks;
 
 use crate::database::VerifiedPair;
 use crate::view_graph::ViewGraph;

@@ -3,7 +3,7 @@
 //! raw matches.
 
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
-use super::{triangulation_angle, Inputs, PriorValues};
+use super::{triangulation_angle, unique_tracks, Inputs, PriorValues};
 use crate::camera::CameraModel;
 use crate::database::Database;
 use crate::focal::{self, FundamentalPair};
@@ -50,6 +50,10 @@ pub fn compute(
     }
     if wants("overlap") {
         values.push(overlap::compute(inputs));
+    }
+    if wants("unique_tracks") {
+        stage("following tracks");
+        values.push(unique_tracks::compute(inputs));
     }
     if names.iter().any(|n| n.starts_with("context")) {
         stage("computing context similarity");

@@ -1,0 +1,130 @@
+//! Pair prior (beyond the paper, after Yan et al. 2017, "Distinguishing the indistinguishable"):
+//! the share of a pair's inliers whose track is not confusing.
+//!
+//! Tracks are the connected components of all verified inlier matches. A feature on a duplicated
+//! structure is matched across the copies, so its track joins the observations of every copy and
+//! grows far longer than tracks on unique structure (walls, background), which only the images
+//! near one place see. False pairs between copies match little else than such confusing tracks;
+//! true pairs share unique ones too. A track is confusing when it is seen by more than
+//! [`CONFUSING_FACTOR`] times the median number of images per track (scale-free: the median
+//! follows how densely the scene was photographed). Measured on the rendered duplicate scenes
+//! (docs/priors.md): factor 4 separates better than 2 or 3 and as well as a smooth 1/length.
+
+use super::{Inputs, PriorValues};
+use petgraph::unionfind::UnionFind;
+
+/// A track seen by more images than this many times the median is confusing.
+pub const CONFUSING_FACTOR: usize = 4;
+
+pub fn compute(inputs: &Inputs) -> PriorValues {
+    let graph = inputs.graph;
+    // One union-find element per keypoint of every vertex.
+    let mut offset = Vec::with_capacity(inputs.keypoints.len() + 1);
+    offset.push(0usize);
+    for k in &inputs.keypoints {
+        offset.push(offset.last().unwrap() + k.len());
+    }
+    let element = |v: u32, kp: u32| offset[v as usize] + kp as usize;
+    let mut tracks = UnionFind::<usize>::new(*offset.last().unwrap());
+    for (edge, e) in graph.edges.iter().enumerate() {
+        for [a, b] in inputs.edge_inliers(edge) {
+            tracks.union(element(e.i, a), element(e.j, b));
+        }
+    }
+    // Images per track: distinct (root, image) of every matched keypoint.
+    let mut observations: Vec<(usize, u32)> = Vec::new();
+    for (edge, e) in graph.edges.iter().enumerate() {
+        for [a, b] in inputs.edge_inliers(edge) {
+            observations.push((tracks.find(element(e.i, a)), e.i));
+            observations.push((tracks.find(element(e.j, b)), e.j));
+        }
+    }
+    observations.sort_unstable();
+    observations.dedup();
+    let mut images_of = std::collections::HashMap::new();
+    for &(root, _) in &observations {
+        *images_of.entry(root).or_insert(0usize) += 1;
+    }
+    let mut lengths: Vec<usize> = images_of.values().copied().collect();
+    let limit = if lengths.is_empty() {
+        0
+    } else {
+        let mid = lengths.len() / 2;
+        CONFUSING_FACTOR * *lengths.select_nth_unstable(mid).1
+    };
+    let values = graph
+        .edges
+        .iter()
+        .enumerate()
+        .map(|(edge, e)| {
+            let (mut unique, mut all) = (0usize, 0usize);
+            for [a, _] in inputs.edge_inliers(edge) {
+                all += 1;
+                unique += (images_of[&tracks.find(element(e.i, a))] <= limit) as usize;
+            }
+            if all == 0 {
+                0.0
+            } else {
+                unique as f64 / all as f64
+            }
+        })
+        .collect();
+    PriorValues {
+        name: "unique_tracks",
+        values,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::database::{Image, VerifiedPair};
+    use crate::view_graph::ViewGraph;
+
+    fn pair(a: u32, b: u32, inliers: Vec<[u32; 2]>) -> VerifiedPair {
+        VerifiedPair {
+            image_id1: a,
+            image_id2: b,
+            config: 2,
+            inliers,
+        }
+    }
+
+    #[test]
+    fn inliers_on_a_track_seen_everywhere_are_confusing() {
+        // 12 images in a chain: neighbours share their own short tracks (keypoints 1..=4), and
+        // keypoint 0 of every image is matched to keypoint 0 of every other image: one track
+        // seen by all 12 images, 6 times the median (2).
+        let n = 12;
+        let images: Vec<Image> = (1..=n)
+            .map(|id| Image {
+                image_id: id,
+                name: id.to_string(),
+                camera_id: 1,
+            })
+            .collect();
+        let mut pairs = Vec::new();
+        for a in 1..=n {
+            for b in a + 1..=n {
+                let mut inliers = vec![[0, 0]];
+                if b == a + 1 {
+                    // Keypoints 1..=2 of a meet 3..=4 of b: tracks of two images each.
+                    inliers.extend([[1, 3], [2, 4]]);
+                }
+                pairs.push(pair(a, b, inliers));
+            }
+        }
+        let graph = ViewGraph::build(&images, &pairs, 1);
+        let inputs = Inputs {
+            graph: &graph,
+            pairs: &pairs,
+            keypoints: vec![vec![[0.0, 0.0]; 5]; n as usize],
+            image_sizes: vec![(100, 100); n as usize],
+        };
+        let v = compute(&inputs);
+        for (e, value) in graph.edges.iter().zip(&v.values) {
+            let expected = if e.j == e.i + 1 { 2.0 / 3.0 } else { 0.0 };
+            assert!((value - expected).abs() < 1e-12, "{e:?}: {value}");
+        }
+    }
+}
