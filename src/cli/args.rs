@@ -1,0 +1,134 @@
+//! Arguments shared by several subcommands (the database, the flow rule, the preset) and the
+//! value parsers that check option values.
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+use std::time::Duration;
+use vgsel_colmap::costs::CostModel;
+use vgsel_colmap::database::Database;
+use vgsel_colmap::search::{Criteria, FlowRule};
+
+#[derive(Args)]
+pub struct DatabaseArg {
+    /// COLMAP database (SQLite) written by feature_extractor and a matcher.
+    #[arg(
+        long = "database_path",
+        visible_alias = "database-path",
+        value_name = "DB"
+    )]
+    pub database_path: PathBuf,
+    /// Seconds to wait for another process's lock on DB (COLMAP GUI, a running matcher) before
+    /// giving up with an error.
+    #[arg(long = "lock_timeout", visible_alias = "lock-timeout", value_name = "SECONDS", default_value_t = 5.0, value_parser = lock_seconds)]
+    lock_timeout: f64,
+}
+
+impl DatabaseArg {
+    pub fn open(&self, read_only: bool) -> Result<Database> {
+        let timeout = Duration::from_secs_f64(self.lock_timeout);
+        Database::open_with_lock_timeout(&self.database_path, read_only, timeout)
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum Preset {
+    /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
+    /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
+    General,
+    /// Pair priors context similarity, loop consistency, multiple motions, for scenes with
+    /// duplicate or symmetric structure. Search: 80% of images, 5 pairs per image.
+    Disambiguation,
+}
+
+impl Preset {
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::General => "general",
+            Preset::Disambiguation => "disambiguation",
+        }
+    }
+
+    pub fn model(self) -> CostModel {
+        match self {
+            Preset::General => CostModel::general(),
+            Preset::Disambiguation => CostModel::disambiguation(),
+        }
+    }
+
+    /// The paper's flow-search criteria: (image fraction, pairs per image).
+    pub fn criteria(self) -> (f64, f64) {
+        match self {
+            Preset::General => (0.9, 20.0),
+            Preset::Disambiguation => (0.8, 5.0),
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct FlowArgs {
+    /// Use this total flow F instead of searching for it.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image"])]
+    pub flow: Option<u64>,
+    /// Search: smallest F selecting at least this fraction of the view graph's images
+    /// [default: 0.9, disambiguation preset 0.8].
+    #[arg(long = "min_image_fraction", visible_alias = "min-image-fraction", value_parser = fraction)]
+    min_image_fraction: Option<f64>,
+    /// Search: ... and at least this many pairs per image (capped at all pairs)
+    /// [default: 20, disambiguation preset 5].
+    #[arg(long = "min_pairs_per_image", visible_alias = "min-pairs-per-image", value_parser = non_negative)]
+    min_pairs_per_image: Option<f64>,
+}
+
+impl FlowArgs {
+    /// The flow rule, with `defaults` (image fraction, pairs per image) for unset criteria.
+    pub fn rule(&self, defaults: (f64, f64)) -> FlowRule {
+        match self.flow {
+            Some(f) => FlowRule::Fixed(f),
+            None => FlowRule::Criteria(Criteria {
+                min_image_fraction: self.min_image_fraction.unwrap_or(defaults.0),
+                min_pairs_per_image: self.min_pairs_per_image.unwrap_or(defaults.1),
+            }),
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Weights(pub Vec<(String, f64)>);
+
+pub fn weights(s: &str) -> Result<Weights, String> {
+    s.split(',')
+        .filter(|w| !w.is_empty())
+        .map(
+            |w| match w.split_once('=').map(|(n, x)| (n, non_negative(x))) {
+                Some((n, Ok(x))) => Ok((n.to_string(), x)),
+                _ => Err(format!(
+                    "`{w}` is not NAME=WEIGHT with a non-negative weight"
+                )),
+            },
+        )
+        .collect::<Result<_, _>>()
+        .map(Weights)
+}
+
+fn fraction(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
+        _ => Err(format!("`{s}` is not a number in [0, 1]")),
+    }
+}
+
+fn non_negative(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x >= 0.0 && x.is_finite() => Ok(x),
+        _ => Err(format!("`{s}` is not a non-negative number")),
+    }
+}
+
+/// SQLite keeps its busy timeout in milliseconds as a C int, so a week is a safe upper bound.
+fn lock_seconds(s: &str) -> Result<f64, String> {
+    match non_negative(s) {
+        Ok(x) if x <= 604_800.0 => Ok(x),
+        _ => Err(format!("`{s}` is not a number of seconds in [0, 604800]")),
+    }
+}

@@ -1,0 +1,173 @@
+//! `generate`: writes synthetic test data: a matched COLMAP database with its ground truth, a
+//! view graph for `solve`, or rendered images with ground-truth poses.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use std::path::PathBuf;
+use vgsel_colmap::{graph_file, render, synth, synthetic_graph};
+
+#[derive(Subcommand)]
+pub enum GenerateCommand {
+    /// A matched COLMAP 3.8 database of cameras orbiting a synthetic scene, with its ground truth.
+    Database(GenerateDatabaseArgs),
+    /// A synthetic view graph of the paper's supplement in the `solve` text format.
+    Graph(GenerateGraphArgs),
+    /// Rendered PNG images of a textured scene (DIR/images) with ground-truth poses (DIR/gt).
+    Images(GenerateImagesArgs),
+}
+
+#[derive(Args)]
+pub struct GenerateGraphArgs {
+    /// The graph file to write.
+    #[arg(long, value_name = "FILE")]
+    output: PathBuf,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
+    images: u64,
+    #[arg(long)]
+    pairs: u64,
+    /// Images along a line (a facade) or a closed loop (around a building).
+    #[arg(long, value_enum, default_value = "loop")]
+    arrangement: GraphArrangement,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum GraphArrangement {
+    Linear,
+    Loop,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SceneArg {
+    /// One object in a room, cameras orbiting it.
+    Room,
+    /// Two identical objects in differently textured halves of a room, linked by a walk.
+    Duplicate,
+}
+
+#[derive(Args)]
+pub struct GenerateImagesArgs {
+    #[arg(long, value_enum, default_value = "room")]
+    scene: SceneArg,
+    /// Output folder (images/ and gt/ are created in it).
+    #[arg(long, value_name = "DIR")]
+    output: PathBuf,
+    #[arg(
+        long = "num_images",
+        visible_alias = "num-images",
+        default_value_t = 20
+    )]
+    num_images: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(Args)]
+pub struct GenerateDatabaseArgs {
+    /// The database to create (must not exist).
+    #[arg(long, value_name = "DB")]
+    output: PathBuf,
+    /// Also write the ground-truth poses here as a COLMAP text model.
+    #[arg(
+        long = "ground_truth",
+        visible_alias = "ground-truth",
+        value_name = "DIR"
+    )]
+    ground_truth: Option<PathBuf>,
+    #[arg(
+        long = "num_images",
+        visible_alias = "num-images",
+        default_value_t = 24
+    )]
+    num_images: usize,
+    #[arg(
+        long = "num_points",
+        visible_alias = "num-points",
+        default_value_t = 6000
+    )]
+    num_points: usize,
+    /// Half-angle of the cone a point is seen from: narrower means fewer pairs per image.
+    #[arg(
+        long = "view_cone_degrees",
+        visible_alias = "view-cone-degrees",
+        default_value_t = 55.0
+    )]
+    view_cone_degrees: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Duplicate-structure scene: two copies of the object, the second turned by this yaw
+    /// (degrees), with ground-truth pair labels; see `duplicate_scene`.
+    #[arg(
+        long = "duplicate_yaw",
+        visible_alias = "duplicate-yaw",
+        value_name = "DEG"
+    )]
+    duplicate_yaw: Option<f64>,
+    /// Store this focal length as an uncalibrated guess (prior_focal_length = 0, F only).
+    #[arg(
+        long = "stored_focal",
+        visible_alias = "stored-focal",
+        value_name = "PX"
+    )]
+    stored_focal: Option<f64>,
+}
+
+pub fn run(command: &GenerateCommand) -> Result<()> {
+    match command {
+        GenerateCommand::Database(args) => run_database(args),
+        GenerateCommand::Images(args) => {
+            let kind = match args.scene {
+                SceneArg::Room => render::SceneKind::Room,
+                SceneArg::Duplicate => render::SceneKind::Duplicate,
+            };
+            render::Scene::build(kind, args.num_images, args.seed)
+                .and_then(|scene| scene.write(&args.output))
+        }
+        GenerateCommand::Graph(args) => run_graph(args),
+    }
+}
+
+/// Overview images of a generated duplicate scene (they link the two camera groups).
+const DUPLICATE_OVERVIEW_IMAGES: usize = 4;
+
+fn run_database(args: &GenerateDatabaseArgs) -> Result<()> {
+    let spec = synth::SceneSpec {
+        num_images: args.num_images,
+        num_points: args.num_points,
+        view_cone_degrees: args.view_cone_degrees,
+        seed: args.seed,
+        layout: match args.duplicate_yaw {
+            Some(yaw_degrees) => synth::Layout::Duplicate {
+                yaw_degrees,
+                overview_images: DUPLICATE_OVERVIEW_IMAGES,
+            },
+            None => synth::Layout::Orbit,
+        },
+        stored_focal: args.stored_focal,
+        ..Default::default()
+    };
+    let gt = synth::generate(&spec, &args.output)?;
+    if let Some(dir) = &args.ground_truth {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        synth::write_gt_model(&gt, dir)?;
+    }
+    Ok(())
+}
+
+fn run_graph(args: &GenerateGraphArgs) -> Result<()> {
+    let (n, e) = (args.images, args.pairs);
+    if e > n * (n - 1) / 2 {
+        bail!(
+            "--pairs {e} do not fit {n} images (at most {})",
+            n * (n - 1) / 2
+        );
+    }
+    let arrangement = match args.arrangement {
+        GraphArrangement::Linear => synthetic_graph::Arrangement::Linear,
+        GraphArrangement::Loop => synthetic_graph::Arrangement::Loop,
+    };
+    let problem = synthetic_graph::generate(n as usize, e as usize, arrangement, args.seed);
+    std::fs::write(&args.output, graph_file::write(&problem))
+        .with_context(|| format!("cannot write graph {}", args.output.display()))
+}

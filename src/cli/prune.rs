@@ -1,0 +1,250 @@
+//! `prune`: selects the pairs the mapper should use and invalidates the others in
+//! two_view_geometries, in place (reversible by `restore`) or in a copy.
+
+use super::args::{weights, DatabaseArg, FlowArgs, Preset, Weights};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use vgsel_colmap::database::Database;
+use vgsel_colmap::overrides::{NameList, Overrides};
+use vgsel_colmap::progress::Progress;
+use vgsel_colmap::search::FlowRule;
+use vgsel_colmap::{
+    export, plots, prune,
+    report::{Outputs, Report},
+    rewrite, scores,
+};
+
+#[derive(Args)]
+pub struct PruneArgs {
+    #[command(flatten)]
+    database: DatabaseArg,
+    #[command(flatten)]
+    flow: FlowArgs,
+    /// Write the pruned database here and leave DB untouched.
+    #[arg(long, value_name = "OUT.db")]
+    output: Option<PathBuf>,
+    /// Allow --output to replace an existing file.
+    #[arg(long)]
+    overwrite: bool,
+    /// Decide and report, write nothing.
+    #[arg(long = "dry_run", visible_alias = "dry-run")]
+    dry_run: bool,
+    /// A pair is a view-graph edge when it has at least this many verified inliers.
+    #[arg(
+        long = "min_num_matches",
+        visible_alias = "min-num-matches",
+        default_value_t = 15
+    )]
+    min_num_matches: usize,
+    /// Which priors make the costs.
+    #[arg(long, value_enum, default_value = "general")]
+    preset: Preset,
+    /// Override prior weights: NAME=W[,NAME=W...] (names as in --scores' header).
+    #[arg(long, value_name = "NAME=W,...", value_parser = weights, default_value = "")]
+    weights: Weights,
+    /// Write each pair's raw and normalised prior values, cost and selection as CSV here.
+    #[arg(long, value_name = "FILE")]
+    scores: Option<PathBuf>,
+    /// Write a JSON report here (schema: docs/report.md).
+    #[arg(long, value_name = "FILE")]
+    report: Option<PathBuf>,
+    /// Write selection_curve.svg and match_matrix.svg into this directory.
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
+    /// Write the kept pairs as `name1 name2` lines (colmap matches_importer --match_type pairs).
+    #[arg(long = "pairs_out", visible_alias = "pairs-out", value_name = "FILE")]
+    pairs_out: Option<PathBuf>,
+    /// Always keep these pairs (lines `name1 name2`).
+    #[arg(long = "keep_pairs", visible_alias = "keep-pairs", value_name = "FILE")]
+    keep_pairs: Option<PathBuf>,
+    /// Never select these pairs (lines `name1 name2`).
+    #[arg(
+        long = "forbid_pairs",
+        visible_alias = "forbid-pairs",
+        value_name = "FILE"
+    )]
+    forbid_pairs: Option<PathBuf>,
+    /// Never select these images nor any of their pairs (one name a line).
+    #[arg(
+        long = "forbid_images",
+        visible_alias = "forbid-images",
+        value_name = "FILE"
+    )]
+    forbid_images: Option<PathBuf>,
+}
+
+impl PruneArgs {
+    fn overrides(&self) -> Result<Overrides> {
+        let read = |path: &Option<PathBuf>, pairs| {
+            path.as_deref()
+                .map(|p| NameList::read(p, pairs))
+                .transpose()
+        };
+        Ok(Overrides {
+            keep_pairs: read(&self.keep_pairs, true)?,
+            forbid_pairs: read(&self.forbid_pairs, true)?,
+            forbid_images: read(&self.forbid_images, false)?,
+        })
+    }
+}
+
+pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
+    let input = &args.database.database_path;
+    if let Some(out) = &args.output {
+        if out.exists() && !args.overwrite {
+            bail!(
+                "--output {} exists (add --overwrite to replace it)",
+                out.display()
+            );
+        }
+        if out.exists() && same_file(input, out) {
+            bail!(
+                "--output {} is the input database itself (drop --output to prune in place)",
+                out.display()
+            );
+        }
+    }
+    if let Some(report) = &args.report {
+        // Checked before the database is written, so a bad path cannot fail the command after
+        // the prune took effect.
+        let parent = report.parent().filter(|p| !p.as_os_str().is_empty());
+        if report.is_dir() || parent.is_some_and(|p| !p.is_dir()) {
+            bail!(
+                "cannot write report {}: not a file in an existing directory",
+                report.display()
+            );
+        }
+    }
+    let in_place = args.output.is_none() && !args.dry_run;
+    let mut db = args.database.open(!in_place)?;
+    let mut model = args.preset.model();
+    for (name, w) in &args.weights.0 {
+        model.set_weight(name, *w)?;
+    }
+    let options = prune::Options {
+        min_num_matches: args.min_num_matches,
+        rule: args.flow.rule(args.preset.criteria()),
+        model,
+    };
+    let stage = |s: &str| progress.stage(s);
+    let overrides = args.overrides()?;
+    let mut plan = prune::plan_with(&db, &options, &overrides, &stage)?;
+    progress.detail(&format!(
+        "view graph: {} images, {} pairs; network: {} images, {} pairs; flow F = {}",
+        plan.graph.num_vertices(),
+        plan.graph.edges.len(),
+        plan.network.problem.image_costs.len(),
+        plan.network.problem.pairs.len(),
+        plan.search.selection.flow
+    ));
+    let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
+    let criteria = match options.rule {
+        FlowRule::Criteria(c) => Some(c),
+        FlowRule::Fixed(_) => None,
+    };
+    let parameters = serde_json::json!({
+        "preset": args.preset.name(),
+        "min_num_matches": args.min_num_matches,
+        "flow": args.flow.flow,
+        "min_image_fraction": criteria.map(|c| c.min_image_fraction),
+        "min_pairs_per_image": criteria.map(|c| c.min_pairs_per_image),
+        "cost_model": options.model,
+        "keep_pairs": path_text(&args.keep_pairs),
+        "forbid_pairs": path_text(&args.forbid_pairs),
+        "forbid_images": path_text(&args.forbid_images),
+    });
+    // The extra files first: if one cannot be written, the database is still untouched.
+    let mut outputs = Outputs::default();
+    if let Some(path) = &args.pairs_out {
+        std::fs::write(path, export::pairs_list(&plan))
+            .with_context(|| format!("cannot write --pairs_out {}", path.display()))?;
+        outputs.pairs_out = Some(path.display().to_string());
+    }
+    if let Some(path) = &args.scores {
+        scores::write(&plan, path)?;
+    }
+    if let Some(dir) = &args.plots {
+        let files = plots::write(&plan, dir, progress)?;
+        outputs.plots = files.iter().map(|f| f.display().to_string()).collect();
+    }
+    let written_to = if args.dry_run {
+        None
+    } else {
+        stage("writing two_view_geometries");
+        let t = Instant::now();
+        let run = rewrite::RunRecord {
+            parameters: parameters.to_string(),
+            flow: Some(plan.search.selection.flow),
+            images_total: plan.images.len(),
+            images_selected: plan.search.selection.images.iter().filter(|&&s| s).count(),
+            pairs_total: plan.graph.edges.len(),
+            pairs_selected: plan.search.selection.pairs.iter().filter(|&&s| s).count(),
+        };
+        let target = match &args.output {
+            None => {
+                rewrite::apply(&mut db, &plan.invalidate, &run)?;
+                input.clone()
+            }
+            Some(out) => {
+                drop(db);
+                write_pruned_copy(input, out, &plan.invalidate, &run)?;
+                out.clone()
+            }
+        };
+        plan.timings.write = t.elapsed().as_secs_f64();
+        plan.timings.total += plan.timings.write;
+        Some(target.display().to_string())
+    };
+    let mut report = Report::new(&plan, input.display().to_string(), written_to, parameters);
+    report.outputs = outputs;
+    progress.finish();
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report)?;
+        std::fs::write(path, json + "\n")
+            .with_context(|| format!("cannot write report {}", path.display()))?;
+    }
+    if !quiet {
+        eprintln!("{}", report.summary());
+    }
+    Ok(())
+}
+
+/// Copies `input` to a temporary file beside `out`, prunes the copy, then renames it to `out`:
+/// `out` is never half-written, and the temporary file is removed on failure.
+fn write_pruned_copy(
+    input: &Path,
+    out: &Path,
+    invalidate: &[u64],
+    run: &rewrite::RunRecord,
+) -> Result<()> {
+    let name = out
+        .file_name()
+        .context("--output names no file")?
+        .to_string_lossy();
+    rewrite::remove_stale_temporaries(out);
+    let tmp = out.with_file_name(format!(".{name}.vgsel-tmp-{}", std::process::id()));
+    let result = (|| {
+        rewrite::copy_database(input, &tmp, true)?;
+        let mut copy = Database::open(&tmp)?;
+        rewrite::apply(&mut copy, invalidate, run)?;
+        drop(copy);
+        std::fs::rename(&tmp, out)
+            .with_context(|| format!("cannot move the pruned copy to {}", out.display()))
+    })()
+    .with_context(|| format!("cannot write --output {}", out.display()));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+        let journal = format!(
+            "{}-journal",
+            tmp.file_name().unwrap_or_default().to_string_lossy()
+        );
+        let _ = std::fs::remove_file(tmp.with_file_name(journal));
+    }
+    result
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
