@@ -45,6 +45,8 @@ pub struct Plan {
     pub overrides: Listed,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
+    /// View-graph edges left out of the network for a fitness below the cost model's floor.
+    pub below_fitness_floor: usize,
     /// pair_ids of the view-graph edges the selection leaves out.
     pub invalidate: Vec<u64>,
     pub timings: Timings,
@@ -137,9 +139,11 @@ pub fn plan_with(
 
     stage("solving the min-cost flow selection");
     let t = Instant::now();
+    let mut below_fitness_floor = 0;
     for (rule, cost) in resolved.edges.iter_mut().zip(&costs.pair_costs) {
         if *rule == EdgeRule::Free && -cost < options.model.min_pair_fitness {
             *rule = EdgeRule::Forbidden;
+            below_fitness_floor += 1;
         }
     }
     let network = Network::new(&graph, &costs, &resolved);
@@ -166,6 +170,7 @@ pub fn plan_with(
         network,
         overrides: resolved.listed,
         search,
+        below_fitness_floor,
         invalidate,
         timings,
     })

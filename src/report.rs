@@ -33,6 +33,8 @@ pub struct Report {
     pub pairs_total: usize,
     pub pairs_selected: usize,
     pub pairs_invalidated: usize,
+    /// Edges never offered to the flow: fitness below the cost model's `min_pair_fitness`.
+    pub pairs_below_fitness_floor: usize,
     pub graph_before: GraphStats,
     pub graph_after: GraphStats,
     /// Of the flow's selection, before kept pairs are added (see docs/report.md).
@@ -127,6 +129,7 @@ impl Report {
             pairs_total: plan.graph.edges.len(),
             pairs_selected: selection.pairs.iter().filter(|&&s| s).count(),
             pairs_invalidated: plan.invalidate.len(),
+            pairs_below_fitness_floor: plan.below_fitness_floor,
             graph_before: plan.graph.stats(),
             graph_after: after.stats(),
             criteria: plan.search.criteria.clone(),

@@ -1,8 +1,9 @@
-//! End to end on rendered images: the duplicate-structure scene (20 PNGs of 480x360) goes through
-//! `scripts/pipeline.sh` — COLMAP 3.8 SIFT (1024 features), exhaustive matching, `vgsel-colmap
-//! prune`, `colmap mapper` on the full and the pruned database, `vgsel-colmap eval` of both
-//! against the rendered ground truth. Asserts the pruned model's figures; prints the full
-//! model's, which are recorded, not asserted (COLMAP decides them). About 3 minutes on 2 cores.
+//! End to end on rendered images: the duplicate-structure scene (20 PNGs of 480x360, which the
+//! full database reconstructs ghosted) goes through `scripts/pipeline.sh` — COLMAP 3.8 SIFT
+//! (1024 features), exhaustive matching, `vgsel-colmap prune --preset disambiguation`, `colmap
+//! mapper` on the full and the pruned database, `vgsel-colmap eval` of both against the rendered
+//! ground truth. Asserts the pruned model's figures; prints the full model's, which are recorded,
+//! not asserted (COLMAP decides them). About 3 minutes on 2 cores.
 
 use serde_json::Value;
 use std::process::Command;
@@ -22,6 +23,7 @@ fn rendered_duplicate_scene_through_colmap() {
         ])
         .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
         .env("MAX_FEATURES", "1024")
+        .env("PRUNE_ARGS", "--preset disambiguation")
         .env("CAMERA_PARAMS", "400,240,180,0")
         .output()
         .expect("running scripts/pipeline.sh");
@@ -39,17 +41,25 @@ fn rendered_duplicate_scene_through_colmap() {
     assert_eq!(n(full, "images_total"), 20);
     // The prune keeps fewer pairs, and the true pairs left still connect every image.
     let pairs = &pruned["pairs"];
+    let baseline = &pairs["baseline"];
     assert!(n(pruned, "pairs_used") < n(full, "pairs_used"));
-    assert_eq!(n(&pairs["baseline"], "used"), n(full, "pairs_used"));
-    assert_eq!(n(pairs, "true_kept"), n(pairs, "true"), "{pairs}");
+    assert_eq!(n(baseline, "used"), n(full, "pairs_used"));
+    // The scene has pairs between the two copies; the full model is recorded (it ghosts: 12 of
+    // 20 correct when this test was written, COLMAP 3.8).
+    assert!(n(baseline, "false") >= 20, "{pairs}");
+    eprintln!("full model: {} of 20 correct", n(full, "correct"));
+    // Issue 5's outcome: >= 90% of the false pairs removed, every image keeps a selected pair,
+    // the true pairs left connect every image, and the mapper places every camera correctly.
+    assert!(
+        n(pairs, "false_removed") * 10 >= n(baseline, "false") * 9,
+        "{pairs}"
+    );
+    assert_eq!(n(&summary["prune"], "images_selected"), 20);
     assert_eq!(n(pairs, "true_graph_components"), 1, "{pairs}");
-    // The pruned model (measured: 20 registered, 12 correct; the full model also 20 and 12 —
-    // the rest sit on the other copy of the object: the general preset does not disambiguate).
-    assert!(n(pruned, "registered") >= 16, "{pruned}");
-    assert!(n(pruned, "correct") >= 10, "{pruned}");
+    assert_eq!(n(pruned, "registered"), 20, "{pruned}");
+    assert!(n(pruned, "correct") >= 19, "{pruned}");
 }
 
-/// `generate images` writes the PNGs and a COLMAP text model that `eval` reads back as exact.
 #[test]
 fn generate_images_writes_pngs_and_a_ground_truth_eval_accepts() {
     let dir = tempfile::tempdir().unwrap();

@@ -111,7 +111,7 @@ pub fn weights(s: &str) -> Result<Weights, String> {
         .map(Weights)
 }
 
-fn fraction(s: &str) -> Result<f64, String> {
+pub fn fraction(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
         _ => Err(format!("`{s}` is not a number in [0, 1]")),

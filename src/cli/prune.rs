@@ -1,7 +1,7 @@
 //! `prune`: selects the pairs the mapper should use and invalidates the others in
 //! two_view_geometries, in place (reversible by `restore`) or in a copy.
 
-use super::args::{weights, DatabaseArg, FlowArgs, Preset, Weights};
+use super::args::{fraction, weights, DatabaseArg, FlowArgs, Preset, Weights};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -44,6 +44,11 @@ pub struct PruneArgs {
     /// Override prior weights: NAME=W[,NAME=W...] (names as in --scores' header).
     #[arg(long, value_name = "NAME=W,...", value_parser = weights, default_value = "")]
     weights: Weights,
+    /// Pairs whose fitness (−cost, in [0, 1]) is below this are never selected: a floor that
+    /// stops flow paths running from one copy of a duplicated structure to another over
+    /// low-ranked pairs [default: 0, disambiguation preset 0.6].
+    #[arg(long = "min_pair_fitness", visible_alias = "min-pair-fitness", value_parser = fraction)]
+    min_pair_fitness: Option<f64>,
     /// Write each pair's raw and normalised prior values, cost and selection as CSV here.
     #[arg(long, value_name = "FILE")]
     scores: Option<PathBuf>,
@@ -122,6 +127,9 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     let mut model = args.preset.model();
     for (name, w) in &args.weights.0 {
         model.set_weight(name, *w)?;
+    }
+    if let Some(floor) = args.min_pair_fitness {
+        model.min_pair_fitness = floor;
     }
     let options = prune::Options {
         min_num_matches: args.min_num_matches,
