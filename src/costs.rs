@@ -162,8 +162,8 @@ impl CostModel {
                 prior("loop", Trapezoid::RISE, 0.0),
                 prior("loop_fraction", Trapezoid::FRACTION, 1.0),
                 prior("unique_tracks", Trapezoid::FRACTION, 1.0),
-                prior("motion_rotation", Trapezoid::MOTION_ROTATION, 0.5),
-                prior("motion_position", Trapezoid::MOTION_POSITION, 0.5),
+                prior("motion_rotation", Trapezoid::MOTION_ROTATION, 0.0),
+                prior("motion_position", Trapezoid::MOTION_POSITION, 0.0),
             ],
             node_constant: 0.0,
             min_pair_fitness: 0.6,
@@ -192,8 +192,13 @@ impl CostModel {
     }
 
     /// Names of the pair priors, in cost order.
-    pub fn pair_prior_names(&self) -> Vec<&'static str> {
-        self.pair_priors.iter().map(|p| p.name).collect()
+    /// Names of the pair priors to compute: those with a weight, or all of them.
+    pub fn pair_prior_names(&self, unweighted: bool) -> Vec<&'static str> {
+        self.pair_priors
+            .iter()
+            .filter(|p| unweighted || p.weight > 0.0)
+            .map(|p| p.name)
+            .collect()
     }
 }
 
@@ -239,8 +244,12 @@ pub fn compute(
 
 /// Each prior's fitness, and their weighted mean per item. A NaN raw value means the prior does
 /// not apply to that item (no second motion found, no triangle): its fitness is NaN and the mean
-/// is taken over the priors that apply.
+/// is taken over the priors that apply. Priors of weight 0 may be left uncomputed.
 fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorValues>, Vec<f64>) {
+    let models: Vec<&PriorModel> = models
+        .iter()
+        .filter(|m| m.weight > 0.0 || raw.iter().any(|p| p.name == m.name))
+        .collect();
     let fitness: Vec<PriorValues> = models
         .iter()
         .map(|m| {

@@ -80,6 +80,7 @@ pub fn export(db: &Database, format: Format) -> Result<(String, Exported)> {
         min_num_matches,
         rule: FlowRule::Fixed(0),
         model: CostModel::general(),
+        unweighted_priors: true,
     };
     let plan = prune::plan_with(db, &options, &Overrides::default(), &|_| {})?;
     let removed = removed_pair_ids(db)?;

@@ -17,6 +17,10 @@ pub struct Options {
     pub min_num_matches: usize,
     pub rule: FlowRule,
     pub model: CostModel,
+    /// Also compute the model's priors of weight 0 (they do not change the costs): for
+    /// `--scores`. Otherwise they are skipped, which matters at scale (multiple motions run a
+    /// RANSAC per pair).
+    pub unweighted_priors: bool,
 }
 
 /// Seconds spent in each stage.
@@ -132,7 +136,7 @@ pub fn plan_with(
     };
     let image_priors = priors::general_image_priors(&inputs);
     let camera_ids: Vec<u32> = graph.image_ids.iter().map(|id| camera_of[id]).collect();
-    let names = options.model.pair_prior_names();
+    let names = options.model.pair_prior_names(options.unweighted_priors);
     let pair_priors = priors::pairs::compute(db, &inputs, &camera_ids, &names, stage)?;
     let costs = costs::compute(&options.model, &image_priors, &pair_priors.values);
     timings.priors = t.elapsed().as_secs_f64();

@@ -24,6 +24,7 @@ fn guessed_focal_length_is_replaced_by_the_estimate() {
         min_num_matches: 15,
         rule: FlowRule::Fixed(4),
         model: CostModel::general(),
+        unweighted_priors: false,
     };
     let p = plan(&db, &options, &|_| {}).unwrap();
     assert_eq!(p.focal_estimates.len(), 1);

@@ -36,6 +36,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
             min_pairs_per_image: 5.0,
         }),
         model: all_priors(),
+        unweighted_priors: true,
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();
     eprintln!("plan: {:?}", p.timings);

@@ -36,8 +36,10 @@ pub enum Preset {
     /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
     /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
     General,
-    /// Pair priors context similarity, loop consistency, multiple motions, for scenes with
-    /// duplicate or symmetric structure. Search: 80% of images, 5 pairs per image.
+    /// For scenes with duplicate or symmetric structure: pair priors loop consistency (rotations
+    /// and translations of every triangle) and unique tracks, pairs below fitness 0.6 never
+    /// selected; the paper's context and multiple motions at weight 0 (in --scores). Search: 80%
+    /// of images, 5 pairs per image.
     Disambiguation,
 }
 

@@ -41,7 +41,8 @@ pub struct PruneArgs {
     /// Which priors make the costs.
     #[arg(long, value_enum, default_value = "general")]
     preset: Preset,
-    /// Override prior weights: NAME=W[,NAME=W...] (names as in --scores' header).
+    /// Override prior weights: NAME=W[,NAME=W...] (names as in --scores' header). Priors of
+    /// weight 0 are computed only for --scores.
     #[arg(long, value_name = "NAME=W,...", value_parser = weights, default_value = "")]
     weights: Weights,
     /// Pairs whose fitness (−cost, in [0, 1]) is below this are never selected: a floor that
@@ -135,6 +136,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         min_num_matches: args.min_num_matches,
         rule: args.flow.rule(args.preset.criteria()),
         model,
+        unweighted_priors: args.scores.is_some(),
     };
     let stage = |s: &str| progress.stage(s);
     let overrides = args.overrides()?;

@@ -5,16 +5,16 @@
 //! structure is matched across the copies, so its track joins the observations of every copy and
 //! grows far longer than tracks on unique structure (walls, background), which only the images
 //! near one place see. False pairs between copies match little else than such confusing tracks;
-//! true pairs share unique ones too. A track is confusing when it is seen by more than
-//! [`CONFUSING_FACTOR`] times the median number of images per track (scale-free: the median
+//! true pairs share unique ones too. A track is confusing when it has more than
+//! [`CONFUSING_FACTOR`] times the median number of observations per track (scale-free: the median
 //! follows how densely the scene was photographed). Measured on the rendered duplicate scenes
 //! (docs/priors.md): factor 4 separates better than 2 or 3 and as well as a smooth 1/length.
 
 use super::{Inputs, PriorValues};
 use petgraph::unionfind::UnionFind;
 
-/// A track seen by more images than this many times the median is confusing.
-pub const CONFUSING_FACTOR: usize = 4;
+/// A track with more observations than this many times the median is confusing.
+pub const CONFUSING_FACTOR: u32 = 4;
 
 pub fn compute(inputs: &Inputs) -> PriorValues {
     let graph = inputs.graph;
@@ -31,21 +31,20 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
             tracks.union(element(e.i, a), element(e.j, b));
         }
     }
-    // Images per track: distinct (root, image) of every matched keypoint.
-    let mut observations: Vec<(usize, u32)> = Vec::new();
+    // Observations per track: its matched keypoints (one per image on a consistent track).
+    let mut matched = vec![false; *offset.last().unwrap()];
     for (edge, e) in graph.edges.iter().enumerate() {
         for [a, b] in inputs.edge_inliers(edge) {
-            observations.push((tracks.find(element(e.i, a)), e.i));
-            observations.push((tracks.find(element(e.j, b)), e.j));
+            matched[element(e.i, a)] = true;
+            matched[element(e.j, b)] = true;
         }
     }
-    observations.sort_unstable();
-    observations.dedup();
-    let mut images_of = std::collections::HashMap::new();
-    for &(root, _) in &observations {
-        *images_of.entry(root).or_insert(0usize) += 1;
+    let track = tracks.into_labeling();
+    let mut length = vec![0u32; matched.len()];
+    for (k, _) in matched.iter().enumerate().filter(|(_, &m)| m) {
+        length[track[k]] += 1;
     }
-    let mut lengths: Vec<usize> = images_of.values().copied().collect();
+    let mut lengths: Vec<u32> = length.iter().copied().filter(|&l| l > 0).collect();
     let limit = if lengths.is_empty() {
         0
     } else {
@@ -60,7 +59,7 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
             let (mut unique, mut all) = (0usize, 0usize);
             for [a, _] in inputs.edge_inliers(edge) {
                 all += 1;
-                unique += (images_of[&tracks.find(element(e.i, a))] <= limit) as usize;
+                unique += (length[track[element(e.i, a)]] <= limit) as usize;
             }
             if all == 0 {
                 0.0
