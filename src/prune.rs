@@ -49,7 +49,8 @@ pub struct Plan {
     pub overrides: Listed,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
-    /// View-graph edges left out of the network for a fitness below the cost model's floor.
+    /// The fitness floor applied ([`fitness_floor`]) and the edges it left out of the network.
+    pub fitness_floor: f64,
     pub below_fitness_floor: usize,
     /// pair_ids of the view-graph edges the selection leaves out.
     pub invalidate: Vec<u64>,
@@ -143,9 +144,10 @@ pub fn plan_with(
 
     stage("solving the min-cost flow selection");
     let t = Instant::now();
+    let floor = fitness_floor(options, &graph, &costs.pair_costs);
     let mut below_fitness_floor = 0;
     for (rule, cost) in resolved.edges.iter_mut().zip(&costs.pair_costs) {
-        if *rule == EdgeRule::Free && -cost < options.model.min_pair_fitness {
+        if *rule == EdgeRule::Free && -cost < floor {
             *rule = EdgeRule::Forbidden;
             below_fitness_floor += 1;
         }
@@ -174,8 +176,81 @@ pub fn plan_with(
         network,
         overrides: resolved.listed,
         search,
+        fitness_floor: floor,
         below_fitness_floor,
         invalidate,
         timings,
     })
+}
+
+/// The cost model's `min_pair_fitness`, lowered where needed so that as many images keep a pair
+/// that reaches it as the search's image criterion asks for: on scenes where the priors score
+/// every pair low (real photos where few triangles close within the loop tolerance) a fixed
+/// floor would leave the flow nothing to select. With a fixed flow it is applied as given.
+pub fn fitness_floor(options: &Options, graph: &ViewGraph, pair_costs: &[f64]) -> f64 {
+    let floor = options.model.min_pair_fitness;
+    let FlowRule::Criteria(criteria) = &options.rule else {
+        return floor;
+    };
+    let n = graph.num_vertices();
+    let wanted = ((criteria.min_image_fraction * n as f64).ceil() as usize).min(n);
+    if floor <= 0.0 || wanted == 0 {
+        return floor;
+    }
+    // Each image's best pair fitness; the wanted-th best image sets the highest usable floor.
+    let mut best = vec![0.0f64; n];
+    for (e, cost) in graph.edges.iter().zip(pair_costs) {
+        for v in [e.i as usize, e.j as usize] {
+            best[v] = best[v].max(-cost);
+        }
+    }
+    let (_, kth, _) = best.select_nth_unstable_by(wanted - 1, |a, b| b.total_cmp(a));
+    floor.min(*kth)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::search::Criteria;
+
+    #[test]
+    fn the_floor_is_lowered_only_as_far_as_the_image_criterion_needs() {
+        // A path 1-2-3-4-5: pair fitnesses 0.9, 0.8, 0.2, 0.1.
+        let images: Vec<Image> = (1..=5)
+            .map(|id| Image {
+                image_id: id,
+                name: id.to_string(),
+                camera_id: 1,
+            })
+            .collect();
+        let pairs: Vec<VerifiedPair> = (1..5)
+            .map(|a| VerifiedPair {
+                image_id1: a,
+                image_id2: a + 1,
+                config: 2,
+                inliers: vec![[0, 0]; 20],
+            })
+            .collect();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let costs = [-0.9, -0.8, -0.2, -0.1];
+        let options = |fraction: f64, rule: Option<u64>| Options {
+            min_num_matches: 15,
+            rule: match rule {
+                Some(f) => FlowRule::Fixed(f),
+                None => FlowRule::Criteria(Criteria {
+                    min_image_fraction: fraction,
+                    min_pairs_per_image: 5.0,
+                }),
+            },
+            model: CostModel::disambiguation(),
+            unweighted_priors: false,
+        };
+        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already.
+        assert_eq!(fitness_floor(&options(0.6, None), &graph, &costs), 0.6);
+        // Four images need the floor at 0.2, all five at 0.1.
+        assert_eq!(fitness_floor(&options(0.8, None), &graph, &costs), 0.2);
+        assert_eq!(fitness_floor(&options(1.0, None), &graph, &costs), 0.1);
+        // A fixed flow takes the floor as given.
+        assert_eq!(fitness_floor(&options(1.0, Some(3)), &graph, &costs), 0.6);
+    }
 }

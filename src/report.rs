@@ -33,7 +33,10 @@ pub struct Report {
     pub pairs_total: usize,
     pub pairs_selected: usize,
     pub pairs_invalidated: usize,
-    /// Edges never offered to the flow: fitness below the cost model's `min_pair_fitness`.
+    /// The fitness floor applied: the cost model's `min_pair_fitness`, lowered (with a
+    /// searched flow) until the image criterion's number of images keep a pair reaching it.
+    pub fitness_floor: f64,
+    /// Edges never offered to the flow: fitness below `fitness_floor`.
     pub pairs_below_fitness_floor: usize,
     pub graph_before: GraphStats,
     pub graph_after: GraphStats,
@@ -129,6 +132,7 @@ impl Report {
             pairs_total: plan.graph.edges.len(),
             pairs_selected: selection.pairs.iter().filter(|&&s| s).count(),
             pairs_invalidated: plan.invalidate.len(),
+            fitness_floor: plan.fitness_floor,
             pairs_below_fitness_floor: plan.below_fitness_floor,
             graph_before: plan.graph.stats(),
             graph_after: after.stats(),
