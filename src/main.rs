@@ -2,7 +2,7 @@
 
 mod cli;
 
-use clap::{CommandFactory, Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 use vgsel_colmap::progress::Progress;
 
@@ -36,7 +36,7 @@ Exit status: 0 success, 1 error (the database is left unchanged), 2 bad command 
 /// Selects the image pairs COLMAP's mapper should use, by the min-cost network flow of Shah,
 /// Chari and Narayanan ("A Unified View-Graph Selection Framework for Structure from Motion").
 #[derive(Parser)]
-#[command(name = "vgsel-colmap", version, after_help = EXAMPLES)]
+#[command(name = "vgsel-colmap", version, after_help = EXAMPLES, rename_all = "snake_case")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -84,6 +84,19 @@ enum Command {
     Man,
 }
 
+/// The command line as parsed and as documented (completions, man page): the derived one with
+/// the dashed aliases of the underscore options.
+fn command() -> clap::Command {
+    cli::dashed_aliases(Cli::command())
+}
+
+/// [`Parser::parse`], on [`command`].
+fn parse() -> Cli {
+    let mut command = command();
+    let mut matches = command.get_matches_mut();
+    Cli::from_arg_matches_mut(&mut matches).unwrap_or_else(|e| e.format(&mut command).exit())
+}
+
 fn main() -> ExitCode {
     // Rust ignores SIGPIPE, so printing into a closed pipe (`| head`) would panic. The default
     // action ends the process quietly instead; a prune killed so is as safe as any kill (the
@@ -92,7 +105,7 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let cli = Cli::parse();
+    let cli = parse();
     let quiet = cli.quiet;
     let progress = Progress::new(quiet, cli.verbose);
     let result = match cli.command {
@@ -105,12 +118,12 @@ fn main() -> ExitCode {
         Command::Export(args) => cli::export::run(&args, quiet, &progress),
         Command::Completions { shell } => {
             let mut script = Vec::new();
-            clap_complete::generate(shell, &mut Cli::command(), "vgsel-colmap", &mut script);
+            clap_complete::generate(shell, &mut command(), "vgsel-colmap", &mut script);
             cli::print_bytes(&script, "the completion script")
         }
         Command::Man => {
             let mut page = Vec::new();
-            clap_mangen::Man::new(Cli::command())
+            clap_mangen::Man::new(command())
                 .render(&mut page)
                 .map_err(anyhow::Error::from)
                 .and_then(|()| cli::print_bytes(&page, "the man page"))

@@ -10,17 +10,14 @@ use vgsel_colmap::database::Database;
 use vgsel_colmap::search::{Criteria, FlowRule};
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct DatabaseArg {
     /// COLMAP database (SQLite) written by feature_extractor and a matcher.
-    #[arg(
-        long = "database_path",
-        visible_alias = "database-path",
-        value_name = "DB"
-    )]
+    #[arg(long, value_name = "DB")]
     pub database_path: PathBuf,
     /// Seconds to wait for another process's lock on DB (COLMAP GUI, a running matcher) before
     /// giving up with an error.
-    #[arg(long = "lock_timeout", visible_alias = "lock-timeout", value_name = "SECONDS", default_value_t = 5.0, value_parser = lock_seconds)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 5.0, value_parser = lock_seconds)]
     lock_timeout: f64,
 }
 
@@ -68,17 +65,18 @@ impl Preset {
 }
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
-    #[arg(long = "min_image_fraction", visible_alias = "min-image-fraction", value_parser = fraction)]
+    #[arg(long, value_parser = fraction)]
     min_image_fraction: Option<f64>,
     /// Search: ... and at least this many pairs per image (capped at all pairs)
     /// [default: 20, disambiguation preset 5].
-    #[arg(long = "min_pairs_per_image", visible_alias = "min-pairs-per-image", value_parser = non_negative)]
+    #[arg(long, value_parser = non_negative)]
     min_pairs_per_image: Option<f64>,
 }
 

@@ -8,25 +8,18 @@ use vgsel_colmap::database::Database;
 use vgsel_colmap::{eval, pair_truth};
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct EvalArgs {
     /// A COLMAP model folder (binary or text), or a folder of sub-models (mapper's output_path).
     #[arg(long, value_name = "DIR")]
     model: PathBuf,
     /// The ground-truth model (COLMAP text or binary); images are matched by name. Without it
     /// only models and registered images are reported.
-    #[arg(
-        long = "ground_truth",
-        visible_alias = "ground-truth",
-        value_name = "DIR"
-    )]
+    #[arg(long, value_name = "DIR")]
     ground_truth: Option<PathBuf>,
     /// The database the model was made from: reports the pairs the mapper used and, with a
     /// (text) ground truth, labels them true or false by their epipolar error.
-    #[arg(
-        long = "database_path",
-        visible_alias = "database-path",
-        value_name = "DB"
-    )]
+    #[arg(long, value_name = "DB")]
     database_path: Option<PathBuf>,
     /// The database before the prune: adds false pairs removed and true pairs kept.
     #[arg(long, value_name = "ORIGINAL.db", requires = "database_path")]
@@ -36,11 +29,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "FILE", requires_all = ["database_path", "ground_truth"])]
     labels: Option<PathBuf>,
     /// A pair is used by the mapper with at least this many inliers (--Mapper.min_num_matches).
-    #[arg(
-        long = "min_num_matches",
-        visible_alias = "min-num-matches",
-        default_value_t = 15
-    )]
+    #[arg(long, default_value_t = 15)]
     min_num_matches: usize,
 }
 

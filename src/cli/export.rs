@@ -10,6 +10,7 @@ use vgsel_colmap::export;
 use vgsel_colmap::progress::Progress;
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct ExportArgs {
     #[command(flatten)]
     database: DatabaseArg,

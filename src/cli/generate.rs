@@ -17,6 +17,7 @@ pub enum GenerateCommand {
 }
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct GenerateGraphArgs {
     /// The graph file to write.
     #[arg(long, value_name = "FILE")]
@@ -47,69 +48,43 @@ enum SceneArg {
 }
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct GenerateImagesArgs {
     #[arg(long, value_enum, default_value = "room")]
     scene: SceneArg,
     /// Output folder (images/ and gt/ are created in it).
     #[arg(long, value_name = "DIR")]
     output: PathBuf,
-    #[arg(
-        long = "num_images",
-        visible_alias = "num-images",
-        default_value_t = 20
-    )]
+    #[arg(long, default_value_t = 20)]
     num_images: usize,
     #[arg(long, default_value_t = 1)]
     seed: u64,
 }
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct GenerateDatabaseArgs {
     /// The database to create (must not exist).
     #[arg(long, value_name = "DB")]
     output: PathBuf,
     /// Also write the ground-truth poses here as a COLMAP text model.
-    #[arg(
-        long = "ground_truth",
-        visible_alias = "ground-truth",
-        value_name = "DIR"
-    )]
+    #[arg(long, value_name = "DIR")]
     ground_truth: Option<PathBuf>,
-    #[arg(
-        long = "num_images",
-        visible_alias = "num-images",
-        default_value_t = 24
-    )]
+    #[arg(long, default_value_t = 24)]
     num_images: usize,
-    #[arg(
-        long = "num_points",
-        visible_alias = "num-points",
-        default_value_t = 6000
-    )]
+    #[arg(long, default_value_t = 6000)]
     num_points: usize,
     /// Half-angle of the cone a point is seen from: narrower means fewer pairs per image.
-    #[arg(
-        long = "view_cone_degrees",
-        visible_alias = "view-cone-degrees",
-        default_value_t = 55.0
-    )]
+    #[arg(long, default_value_t = 55.0)]
     view_cone_degrees: f64,
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Duplicate-structure scene: two copies of the object, the second turned by this yaw
     /// (degrees), with ground-truth pair labels; see `duplicate_scene`.
-    #[arg(
-        long = "duplicate_yaw",
-        visible_alias = "duplicate-yaw",
-        value_name = "DEG"
-    )]
+    #[arg(long, value_name = "DEG")]
     duplicate_yaw: Option<f64>,
     /// Store this focal length as an uncalibrated guess (prior_focal_length = 0, F only).
-    #[arg(
-        long = "stored_focal",
-        visible_alias = "stored-focal",
-        value_name = "PX"
-    )]
+    #[arg(long, value_name = "PX")]
     stored_focal: Option<f64>,
 }
 

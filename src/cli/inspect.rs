@@ -6,15 +6,12 @@ use anyhow::Result;
 use clap::Args;
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct InspectArgs {
     #[command(flatten)]
     database: DatabaseArg,
     /// A pair counts when it has at least this many verified inliers (as --Mapper.min_num_matches).
-    #[arg(
-        long = "min_num_matches",
-        visible_alias = "min-num-matches",
-        default_value_t = 15
-    )]
+    #[arg(long, default_value_t = 15)]
     min_num_matches: usize,
     /// Print JSON instead of text.
     #[arg(long)]

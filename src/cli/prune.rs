@@ -17,6 +17,7 @@ use vgsel_colmap::{
 };
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct PruneArgs {
     #[command(flatten)]
     database: DatabaseArg,
@@ -29,14 +30,10 @@ pub struct PruneArgs {
     #[arg(long)]
     overwrite: bool,
     /// Decide and report, write nothing.
-    #[arg(long = "dry_run", visible_alias = "dry-run")]
+    #[arg(long)]
     dry_run: bool,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
-    #[arg(
-        long = "min_num_matches",
-        visible_alias = "min-num-matches",
-        default_value_t = 15
-    )]
+    #[arg(long, default_value_t = 15)]
     min_num_matches: usize,
     /// Which priors make the costs.
     #[arg(long, value_enum, default_value = "general")]
@@ -48,7 +45,7 @@ pub struct PruneArgs {
     /// Pairs whose fitness (−cost, in [0, 1]) is below this are never selected: a floor that
     /// stops flow paths running from one copy of a duplicated structure to another over
     /// low-ranked pairs [default: 0, disambiguation preset 0.6].
-    #[arg(long = "min_pair_fitness", visible_alias = "min-pair-fitness", value_parser = fraction)]
+    #[arg(long, value_parser = fraction)]
     min_pair_fitness: Option<f64>,
     /// Write each pair's raw and normalised prior values, cost and selection as CSV here.
     #[arg(long, value_name = "FILE")]
@@ -60,24 +57,16 @@ pub struct PruneArgs {
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
     /// Write the kept pairs as `name1 name2` lines (colmap matches_importer --match_type pairs).
-    #[arg(long = "pairs_out", visible_alias = "pairs-out", value_name = "FILE")]
+    #[arg(long, value_name = "FILE")]
     pairs_out: Option<PathBuf>,
     /// Always keep these pairs (lines `name1 name2`).
-    #[arg(long = "keep_pairs", visible_alias = "keep-pairs", value_name = "FILE")]
+    #[arg(long, value_name = "FILE")]
     keep_pairs: Option<PathBuf>,
     /// Never select these pairs (lines `name1 name2`).
-    #[arg(
-        long = "forbid_pairs",
-        visible_alias = "forbid-pairs",
-        value_name = "FILE"
-    )]
+    #[arg(long, value_name = "FILE")]
     forbid_pairs: Option<PathBuf>,
     /// Never select these images nor any of their pairs (one name a line).
-    #[arg(
-        long = "forbid_images",
-        visible_alias = "forbid-images",
-        value_name = "FILE"
-    )]
+    #[arg(long, value_name = "FILE")]
     forbid_images: Option<PathBuf>,
 }
 

@@ -9,6 +9,7 @@ use std::time::Instant;
 use vgsel_colmap::{graph_file, search};
 
 #[derive(Args)]
+#[command(rename_all = "snake_case")]
 pub struct SolveArgs {
     /// Graph file: line 1 `V E`, V image costs, E lines `i j cost` (0-based, i < j), costs in [-1, 0].
     #[arg(long, value_name = "FILE")]
