@@ -44,7 +44,8 @@ pub struct PruneArgs {
     weights: Weights,
     /// Pairs whose fitness (−cost, in [0, 1]) is below this are never selected: a floor that
     /// stops flow paths running from one copy of a duplicated structure to another over
-    /// low-ranked pairs [default: 0, disambiguation preset 0.6].
+    /// low-ranked pairs. With a searched flow it is lowered until the image criterion's share
+    /// of images keep a pair above it [default: 0, disambiguation preset 0.6].
     #[arg(long, value_parser = fraction)]
     min_pair_fitness: Option<f64>,
     /// Write each pair's raw and normalised prior values, cost and selection as CSV here.
