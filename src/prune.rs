@@ -183,29 +183,38 @@ pub fn plan_with(
     })
 }
 
-/// The cost model's `min_pair_fitness`, lowered where needed so that as many images keep a pair
-/// that reaches it as the search's image criterion asks for: on scenes where the priors score
-/// every pair low (real photos where few triangles close within the loop tolerance) a fixed
-/// floor would leave the flow nothing to select. With a fixed flow it is applied as given.
+/// The cost model's `min_pair_fitness`, lowered where needed so that the image criterion's
+/// share of images keep a pair above it, and at least half as many pairs as the pair criterion
+/// asks for reach it. On scenes where the priors score every pair low (real photos where few
+/// triangles close within the loop tolerance) a fixed floor left the flow too few pairs for
+/// `colmap mapper` to start a model (docs/priors.md). With a fixed flow it is applied as given.
 pub fn fitness_floor(options: &Options, graph: &ViewGraph, pair_costs: &[f64]) -> f64 {
     let floor = options.model.min_pair_fitness;
     let FlowRule::Criteria(criteria) = &options.rule else {
         return floor;
     };
     let n = graph.num_vertices();
-    let wanted = ((criteria.min_image_fraction * n as f64).ceil() as usize).min(n);
-    if floor <= 0.0 || wanted == 0 {
+    if floor <= 0.0 || n == 0 {
         return floor;
     }
-    // Each image's best pair fitness; the wanted-th best image sets the highest usable floor.
+    // The k-th largest of some values (k >= 1, at most their count).
+    let kth = |mut values: Vec<f64>, k: usize| {
+        let k = k.clamp(1, values.len());
+        *values
+            .select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a))
+            .1
+    };
+    // Each image's best pair fitness: the wanted-th best image sets the highest usable floor.
     let mut best = vec![0.0f64; n];
     for (e, cost) in graph.edges.iter().zip(pair_costs) {
         for v in [e.i as usize, e.j as usize] {
             best[v] = best[v].max(-cost);
         }
     }
-    let (_, kth, _) = best.select_nth_unstable_by(wanted - 1, |a, b| b.total_cmp(a));
-    floor.min(*kth)
+    let images = (criteria.min_image_fraction * n as f64).ceil() as usize;
+    let pairs = (criteria.min_pairs_per_image * n as f64 / 2.0).ceil() as usize;
+    let fitness = pair_costs.iter().map(|c| -c).collect();
+    floor.min(kth(best, images)).min(kth(fitness, pairs))
 }
 
 #[cfg(test)]
@@ -214,7 +223,7 @@ mod tests {
     use crate::search::Criteria;
 
     #[test]
-    fn the_floor_is_lowered_only_as_far_as_the_image_criterion_needs() {
+    fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {
         // A path 1-2-3-4-5: pair fitnesses 0.9, 0.8, 0.2, 0.1.
         let images: Vec<Image> = (1..=5)
             .map(|id| Image {
@@ -233,24 +242,30 @@ mod tests {
             .collect();
         let graph = ViewGraph::build(&images, &pairs, 15);
         let costs = [-0.9, -0.8, -0.2, -0.1];
-        let options = |fraction: f64, rule: Option<u64>| Options {
+        let options = |fraction: f64, per_image: f64, rule: Option<u64>| Options {
             min_num_matches: 15,
             rule: match rule {
                 Some(f) => FlowRule::Fixed(f),
                 None => FlowRule::Criteria(Criteria {
                     min_image_fraction: fraction,
-                    min_pairs_per_image: 5.0,
+                    min_pairs_per_image: per_image,
                 }),
             },
             model: CostModel::disambiguation(),
             unweighted_priors: false,
         };
-        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already.
-        assert_eq!(fitness_floor(&options(0.6, None), &graph, &costs), 0.6);
+        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already, and
+        // half of 0.4 pairs per image x 5 images is one pair.
+        assert_eq!(fitness_floor(&options(0.6, 0.4, None), &graph, &costs), 0.6);
         // Four images need the floor at 0.2, all five at 0.1.
-        assert_eq!(fitness_floor(&options(0.8, None), &graph, &costs), 0.2);
-        assert_eq!(fitness_floor(&options(1.0, None), &graph, &costs), 0.1);
+        assert_eq!(fitness_floor(&options(0.8, 0.4, None), &graph, &costs), 0.2);
+        assert_eq!(fitness_floor(&options(1.0, 0.4, None), &graph, &costs), 0.1);
+        // Half of 1.2 pairs per image x 5 images is 3 pairs: the third best is 0.2.
+        assert_eq!(fitness_floor(&options(0.6, 1.2, None), &graph, &costs), 0.2);
         // A fixed flow takes the floor as given.
-        assert_eq!(fitness_floor(&options(1.0, Some(3)), &graph, &costs), 0.6);
+        assert_eq!(
+            fitness_floor(&options(1.0, 1.2, Some(3)), &graph, &costs),
+            0.6
+        );
     }
 }
