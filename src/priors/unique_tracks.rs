@@ -25,18 +25,16 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
         offset.push(offset.last().unwrap() + k.len());
     }
     let element = |v: u32, kp: u32| offset[v as usize] + kp as usize;
-    let mut tracks = UnionFind::<usize>::new(*offset.last().unwrap());
+    let keypoints = *offset.last().unwrap();
+    let mut tracks = UnionFind::<usize>::new(keypoints);
+    // Observations per track are its matched keypoints (one per image on a consistent track).
+    let mut matched = vec![false; keypoints];
     for (edge, e) in graph.edges.iter().enumerate() {
         for [a, b] in inputs.edge_inliers(edge) {
-            tracks.union(element(e.i, a), element(e.j, b));
-        }
-    }
-    // Observations per track: its matched keypoints (one per image on a consistent track).
-    let mut matched = vec![false; *offset.last().unwrap()];
-    for (edge, e) in graph.edges.iter().enumerate() {
-        for [a, b] in inputs.edge_inliers(edge) {
-            matched[element(e.i, a)] = true;
-            matched[element(e.j, b)] = true;
+            let (x, y) = (element(e.i, a), element(e.j, b));
+            tracks.union(x, y);
+            matched[x] = true;
+            matched[y] = true;
         }
     }
     let track = tracks.into_labeling();
