@@ -5,9 +5,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use vgsel_colmap::database::{Image, VerifiedPair};
+use vgsel_colmap::colmap::database::{Image, VerifiedPair};
 use vgsel_colmap::priors::{overlap, track_fraction, Inputs};
-use vgsel_colmap::view_graph::ViewGraph;
+use vgsel_colmap::scene::view_graph::ViewGraph;
 
 const IMAGES: u32 = 300;
 const NEIGHBOURS: u32 = 20;

@@ -17,7 +17,7 @@ use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-use vgsel_colmap::synth::{generate, SceneSpec};
+use vgsel_colmap::eval::synth::{generate, SceneSpec};
 
 const PRUNE: [&str; 3] = ["--min_pairs_per_image", "4", "-q"];
 

@@ -6,7 +6,7 @@ use common::Layout; // not database::Layout
 use common::*;
 use rusqlite::{params, Connection};
 use std::time::Duration;
-use vgsel_colmap::database::*;
+use vgsel_colmap::colmap::database::*;
 
 fn err<T>(r: anyhow::Result<T>) -> String {
     match r {

@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 use tempfile::TempDir;
-use vgsel_colmap::database::image_ids;
-use vgsel_colmap::synth::{generate, SceneSpec};
+use vgsel_colmap::colmap::database::image_ids;
+use vgsel_colmap::eval::synth::{generate, SceneSpec};
 
 /// Every file under `dir` (names relative to it) with its bytes.
 fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {

@@ -3,9 +3,9 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashSet;
-use vgsel_colmap::network::{PairArc, Selection, SelectionProblem};
-use vgsel_colmap::search::{search, targets, Criteria, FlowRule, SearchResult};
-use vgsel_colmap::solver::{solve, ParametricSolver};
+use vgsel_colmap::flow::network::{PairArc, Selection, SelectionProblem};
+use vgsel_colmap::flow::search::{search, targets, Criteria, FlowRule, SearchResult};
+use vgsel_colmap::flow::solver::{solve, ParametricSolver};
 
 fn random_problem(n: usize, m: usize, seed: u64) -> SelectionProblem {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -40,7 +40,7 @@ fn criteria(a: f64, b: f64) -> FlowRule {
     })
 }
 
-fn status<'a>(r: &'a SearchResult, name: &str) -> &'a vgsel_colmap::search::CriterionStatus {
+fn status<'a>(r: &'a SearchResult, name: &str) -> &'a vgsel_colmap::flow::search::CriterionStatus {
     r.criteria.iter().find(|c| c.name == name).unwrap()
 }
 

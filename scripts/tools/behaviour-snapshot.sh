@@ -53,7 +53,7 @@ for preset in general disambiguation; do
   "$bin" -q export --database_path "$preset/pruned.db" --format graphml --output "$preset/graph.graphml"
   "$bin" -q restore --database_path "$preset/pruned.db"
   dump "$preset/pruned.db" >"$preset/restored.sql"
-  rm "$preset/in.db" "$preset/pruned.db"
+  rm -f "$preset"/in.db* "$preset"/pruned.db*
 done
 dump "$db" >original.sql
 cmp -s original.sql general/restored.sql && cmp -s original.sql disambiguation/restored.sql \

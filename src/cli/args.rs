@@ -5,9 +5,9 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::time::Duration;
+use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::costs::CostModel;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::search::{Criteria, FlowRule};
+use vgsel_colmap::flow::search::{Criteria, FlowRule};
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]

@@ -4,8 +4,8 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::{eval, pair_truth};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::eval::{pair_truth, score as eval};
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]

@@ -5,8 +5,8 @@ use super::args::DatabaseArg;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::export;
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::outputs::export;
 use vgsel_colmap::progress::Progress;
 
 #[derive(Args)]

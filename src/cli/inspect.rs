@@ -22,7 +22,8 @@ pub fn run(args: &InspectArgs) -> Result<()> {
     let db = args.database.open(true)?;
     let images = db.images()?;
     let pairs = db.verified_pairs()?;
-    let graph = vgsel_colmap::view_graph::ViewGraph::build(&images, &pairs, args.min_num_matches);
+    let graph =
+        vgsel_colmap::scene::view_graph::ViewGraph::build(&images, &pairs, args.min_num_matches);
     let stats = graph.stats();
     let pruned = db.is_pruned()?;
     if args.json {

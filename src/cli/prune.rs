@@ -6,15 +6,14 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::overrides::{NameList, Overrides};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::rewrite;
+use vgsel_colmap::flow::search::FlowRule;
+use vgsel_colmap::outputs::report::{Outputs, Report};
+use vgsel_colmap::outputs::{export, plots, scores};
 use vgsel_colmap::progress::Progress;
-use vgsel_colmap::search::FlowRule;
-use vgsel_colmap::{
-    export, plots, prune,
-    report::{Outputs, Report},
-    rewrite, scores,
-};
+use vgsel_colmap::selection::overrides::{NameList, Overrides};
+use vgsel_colmap::selection::pipeline as prune;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]

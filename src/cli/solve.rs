@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
-use vgsel_colmap::{graph_file, search};
+use vgsel_colmap::flow::{graph_file, search};
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]

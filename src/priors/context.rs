@@ -119,8 +119,8 @@ pub fn compute(inputs: &Inputs) -> Vec<PriorValues> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::database::{Image, VerifiedPair};
-    use crate::view_graph::ViewGraph;
+    use crate::colmap::database::{Image, VerifiedPair};
+    use crate::scene::view_graph::ViewGraph;
 
     /// Images 1, 2 see copy A with surroundings seen by image 3; image 4 sees copy B with
     /// surroundings seen by image 5. Pair (1, 2) is true, pair (1, 4) false: the copies match

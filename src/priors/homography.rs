@@ -9,8 +9,8 @@
 //! for get one fitted (RANSAC) to their normalised inliers.
 
 use super::{Inputs, PriorValues};
-use crate::geometry::{estimate_homography, homography_inliers};
-use crate::view_geometry::ViewGeometry;
+use crate::geometry::pose::{estimate_homography, homography_inliers};
+use crate::geometry::view_geometry::ViewGeometry;
 use anyhow::Result;
 use nalgebra::Matrix3;
 use rayon::prelude::*;

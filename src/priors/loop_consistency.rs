@@ -9,7 +9,7 @@
 //! count favours pairs in dense regions whatever their truth.
 
 use super::{Inputs, PriorValues};
-use crate::geometry::{rotation_angle_deg, RelativePose};
+use crate::geometry::pose::{rotation_angle_deg, RelativePose};
 use nalgebra::Rotation3;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -113,7 +113,7 @@ pub fn compute(inputs: &Inputs, poses: &[Option<RelativePose>]) -> Vec<PriorValu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::PoseSource;
+    use crate::geometry::pose::PoseSource;
     use nalgebra::{Unit, Vector3};
 
     /// Pose a -> b of two world-to-camera poses.

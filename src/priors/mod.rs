@@ -19,8 +19,8 @@ pub mod track_fraction;
 pub mod triangulation_angle;
 pub mod unique_tracks;
 
-use crate::database::VerifiedPair;
-use crate::view_graph::ViewGraph;
+use crate::colmap::database::VerifiedPair;
+use crate::scene::view_graph::ViewGraph;
 
 /// Raw values of one prior: one per vertex (image prior) or per edge (pair prior).
 #[derive(Clone, Debug, PartialEq)]

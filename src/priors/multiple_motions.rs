@@ -5,8 +5,8 @@
 //! (degrees); both are NaN (left out of the cost) where no second motion is found.
 
 use super::{Inputs, PriorValues};
-use crate::geometry::{direction_angle_deg, estimate_pose, rotation_angle_deg, RelativePose};
-use crate::view_geometry::ViewGeometry;
+use crate::geometry::pose::{direction_angle_deg, estimate_pose, rotation_angle_deg, RelativePose};
+use crate::geometry::view_geometry::ViewGeometry;
 use anyhow::Result;
 use rayon::prelude::*;
 use std::collections::HashSet;
@@ -84,7 +84,7 @@ pub fn compute(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tests::two_view;
+    use crate::geometry::pose::tests::two_view;
     use nalgebra::{Rotation3, Vector3};
 
     #[test]

@@ -4,10 +4,10 @@
 
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
 use super::{triangulation_angle, unique_tracks, Inputs, PriorValues};
-use crate::camera::CameraModel;
-use crate::database::Database;
-use crate::focal::{self, FundamentalPair};
-use crate::view_geometry::{self, ViewGeometry};
+use crate::colmap::database::Database;
+use crate::geometry::camera::CameraModel;
+use crate::geometry::focal::{self, FundamentalPair};
+use crate::geometry::view_geometry::{self, ViewGeometry};
 use anyhow::{Context, Result};
 use nalgebra::Matrix3;
 use serde::Serialize;

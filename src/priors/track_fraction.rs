@@ -31,8 +31,8 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::database::{Image, VerifiedPair};
-    use crate::view_graph::ViewGraph;
+    use crate::colmap::database::{Image, VerifiedPair};
+    use crate::scene::view_graph::ViewGraph;
 
     #[test]
     fn counts_each_keypoint_once_across_pairs() {

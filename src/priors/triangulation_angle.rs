@@ -4,8 +4,8 @@
 //! triangulation, get 0.
 
 use super::{Inputs, PriorValues};
-use crate::geometry::{direction_angle_deg, triangulate};
-use crate::view_geometry::ViewGeometry;
+use crate::geometry::pose::{direction_angle_deg, triangulate};
+use crate::geometry::view_geometry::ViewGeometry;
 use rayon::prelude::*;
 
 pub fn compute(inputs: &Inputs, geometry: &ViewGeometry) -> PriorValues {
@@ -45,8 +45,8 @@ pub fn median(values: &mut [f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tests::two_view;
-    use crate::geometry::{PoseSource, RelativePose};
+    use crate::geometry::pose::tests::two_view;
+    use crate::geometry::pose::{PoseSource, RelativePose};
     use nalgebra::{Rotation3, Unit, Vector3};
 
     #[test]

@@ -75,8 +75,8 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::database::{Image, VerifiedPair};
-    use crate::view_graph::ViewGraph;
+    use crate::colmap::database::{Image, VerifiedPair};
+    use crate::scene::view_graph::ViewGraph;
 
     fn pair(a: u32, b: u32, inliers: Vec<[u32; 2]>) -> VerifiedPair {
         VerifiedPair {

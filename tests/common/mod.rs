@@ -6,7 +6,7 @@ use rusqlite::types::Value;
 use rusqlite::{params, Connection};
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
-use vgsel_colmap::database::pair_id;
+use vgsel_colmap::colmap::database::pair_id;
 
 pub const COLMAP_38_SQL: &str = include_str!("../../sql/colmap-3.8.sql");
 pub const COLMAP_LATEST_SQL: &str = include_str!("../../sql/colmap-latest.sql");
@@ -302,8 +302,8 @@ pub fn ok(args: &[&str]) -> std::process::Output {
 pub fn scene() -> (TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let db = dir.path().join("scene.db");
-    vgsel_colmap::synth::generate(
-        &vgsel_colmap::synth::SceneSpec {
+    vgsel_colmap::eval::synth::generate(
+        &vgsel_colmap::eval::synth::SceneSpec {
             num_images: 16,
             num_points: 3000,
             seed: 3,

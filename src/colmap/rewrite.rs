@@ -7,14 +7,16 @@
 //! `vgsel_backup` (sql/vgsel.sql), whose untyped columns keep each value's storage class, so a
 //! restore is byte for byte.
 
-use crate::database::{image_ids, sql_error, table_exists, Database, SqlResult, TWO_VIEW_COLUMNS};
+use crate::colmap::database::{
+    image_ids, sql_error, table_exists, Database, SqlResult, TWO_VIEW_COLUMNS,
+};
 use anyhow::{anyhow, bail, Result};
 use rusqlite::{Connection, OpenFlags, Transaction, TransactionBehavior};
 use std::collections::BTreeSet;
 use std::path::Path;
 
 /// The project's tables (CREATE TABLE IF NOT EXISTS).
-pub const VGSEL_SQL: &str = include_str!("../sql/vgsel.sql");
+pub const VGSEL_SQL: &str = include_str!("../../sql/vgsel.sql");
 
 /// What a prune records in the project's runs table.
 #[derive(Clone, Debug)]

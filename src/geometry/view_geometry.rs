@@ -1,10 +1,10 @@
 //! The geometric inputs of the pose-based priors: each vertex's camera model and undistorted
-//! normalised keypoints, and each edge's relative pose ([`crate::geometry::pair_pose`]).
+//! normalised keypoints, and each edge's relative pose ([`crate::geometry::pose::pair_pose`]).
 //! Computed once per prune, in parallel over images and pairs.
 
-use crate::camera::CameraModel;
-use crate::database::TwoViewGeometry;
-use crate::geometry::{pair_pose, RelativePose, StoredGeometry};
+use crate::colmap::database::TwoViewGeometry;
+use crate::geometry::camera::CameraModel;
+use crate::geometry::pose::{pair_pose, RelativePose, StoredGeometry};
 use crate::priors::Inputs;
 use anyhow::{Context, Result};
 use nalgebra::Matrix3;

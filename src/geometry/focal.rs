@@ -7,7 +7,7 @@
 //! Relative rotations computed with a guessed focal length are wrong by degrees, which is enough
 //! to break loop consistency, so this runs before any pose is used.
 
-use crate::camera::CameraModel;
+use crate::geometry::camera::CameraModel;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 
@@ -95,7 +95,7 @@ pub fn estimate(cameras: &[CameraModel], pairs: &[FundamentalPair]) -> Vec<Optio
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::database::Camera;
+    use crate::colmap::database::Camera;
     use nalgebra::{Rotation3, Vector3};
 
     fn skew(v: &Vector3<f64>) -> Matrix3<f64> {

@@ -14,10 +14,10 @@
 //! --match_type pairs` reads them; one image name per line for images); blank lines and lines
 //! starting with `#` are skipped.
 
+use crate::colmap::database::Image;
 use crate::costs::Costs;
-use crate::database::Image;
-use crate::network::{PairArc, Selection, SelectionProblem};
-use crate::view_graph::ViewGraph;
+use crate::flow::network::{PairArc, Selection, SelectionProblem};
+use crate::scene::view_graph::ViewGraph;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;

@@ -1,9 +1,9 @@
 //! What a prune did: the JSON report (`--report FILE`) and the short summary on stderr.
 
-use crate::overrides::Listed;
-use crate::prune::{Plan, Timings};
-use crate::search::CriterionStatus;
-use crate::view_graph::{GraphStats, ViewGraph};
+use crate::flow::search::CriterionStatus;
+use crate::scene::view_graph::{GraphStats, ViewGraph};
+use crate::selection::overrides::Listed;
+use crate::selection::pipeline::{Plan, Timings};
 use serde::Serialize;
 use std::collections::HashMap;
 

@@ -1,11 +1,11 @@
-//! A duplicate-structure scene for [`crate::synth`]: two identical copies of the default box
+//! A duplicate-structure scene for [`crate::eval::synth`]: two identical copies of the default box
 //! group (same appearance ids, the second turned by a yaw) in distinct surroundings (each on
 //! its own ground disc), two groups of cameras orbiting one copy each, and a few overview
 //! cameras that see both. Cameras of different groups facing their copies from similar angles
 //! match on the object alone: these are the false pairs that make `colmap mapper` fold the two
 //! copies into one ghosted model. The overview cameras truly link the groups.
 
-use crate::synth::{
+use crate::eval::synth::{
     default_surfaces, look_at, sample_surface, GtImage, ScenePoint, SceneSpec, Surface,
 };
 use nalgebra::{Rotation3, Vector3};

@@ -1,8 +1,8 @@
 //! How well priors and a selection separate true from false pairs, against ground-truth labels
-//! (from [`crate::synth`]): each prior's AUC, and what the selection removed and kept.
+//! (from [`crate::eval::synth`]): each prior's AUC, and what the selection removed and kept.
 
-use crate::prune::Plan;
-use crate::synth::GroundTruth;
+use crate::eval::synth::GroundTruth;
+use crate::selection::pipeline::Plan;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
 

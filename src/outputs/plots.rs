@@ -1,8 +1,8 @@
 //! `--plots DIR`: the selection curve (the paper's Figure 3) and COLMAP-style match matrix, as SVG.
 
+use crate::flow::solver::ParametricSolver;
 use crate::progress::Progress;
-use crate::prune::Plan;
-use crate::solver::ParametricSolver;
+use crate::selection::pipeline::Plan;
 use anyhow::{anyhow, Context, Result};
 use plotters::prelude::*;
 use std::collections::HashMap;

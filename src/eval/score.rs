@@ -3,8 +3,8 @@
 //! truth's extent and its rotation within 5 degrees. A ghosted model (one copy's cameras
 //! registered onto the other) registers images that are not correct.
 
-use crate::align;
-use crate::model;
+use crate::colmap::model;
+use crate::eval::align;
 use anyhow::{ensure, Result};
 use serde::Serialize;
 use std::collections::HashMap;

@@ -2,7 +2,7 @@
 //! after g, the pair's cost and whether the selection kept it; for tuning weights and for
 //! checking a prior against ground truth outside this program.
 
-use crate::prune::Plan;
+use crate::selection::pipeline::Plan;
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;

@@ -25,11 +25,13 @@
 //! between observations of equal appearance, and are true only when they come from the same 3D
 //! point. Today every point has its own appearance; a duplicate-structure scene only has to give
 //! two copies of an object the same appearance ids, and [`GtPair::true_pair`] labels the result.
-//! [`Layout::Duplicate`] is such a scene ([`crate::duplicate_scene`]). There, a pair's
+//! [`Layout::Duplicate`] is such a scene ([`crate::eval::synth::duplicate`]). There, a pair's
 //! correspondences fall into motions (same point, or copy a's point matched to copy b's), and the
 //! verified inliers are the largest motion, as RANSAC would keep; the others stay in `matches`.
 
-use crate::model::ModelImage;
+pub mod duplicate;
+
+use crate::colmap::model::ModelImage;
 use anyhow::{bail, ensure, Context, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rand::seq::SliceRandom;
@@ -102,7 +104,7 @@ pub struct SceneSpec {
 pub enum Layout {
     /// Boxes on a ground disc, cameras on an orbit.
     Orbit,
-    /// Two identical objects in distinct surroundings; see [`crate::duplicate_scene`].
+    /// Two identical objects in distinct surroundings; see [`crate::eval::synth::duplicate`].
     Duplicate {
         /// Yaw of the second copy relative to the first (0: a pure translation).
         yaw_degrees: f64,
@@ -190,7 +192,7 @@ pub struct GroundTruth {
 }
 
 impl GroundTruth {
-    /// The poses as a model, for [`crate::align::evaluate`].
+    /// The poses as a model, for [`crate::eval::align::evaluate`].
     pub fn model_images(&self) -> Vec<ModelImage> {
         self.images
             .iter()
@@ -536,7 +538,7 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
         Layout::Duplicate {
             yaw_degrees,
             overview_images,
-        } => crate::duplicate_scene::build(spec, yaw_degrees, overview_images, &mut rng),
+        } => crate::eval::synth::duplicate::build(spec, yaw_degrees, overview_images, &mut rng),
     };
     let camera = GtCamera {
         camera_id: 1,
@@ -566,7 +568,7 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
     }
     let mut conn = Connection::open(database_path)
         .with_context(|| format!("creating {}", database_path.display()))?;
-    conn.execute_batch(include_str!("../sql/colmap-3.8.sql"))
+    conn.execute_batch(include_str!("../../../sql/colmap-3.8.sql"))
         .context("creating the COLMAP 3.8 schema")?;
     let tx = conn.transaction()?;
     let k = Matrix3::new(

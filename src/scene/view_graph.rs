@@ -3,7 +3,7 @@
 //! Vertex indices follow ascending COLMAP image_id, the order that orients the flow network's pair
 //! arcs (the paper's network is a DAG from lower to higher index, so the order matters).
 
-use crate::database::{Image, VerifiedPair};
+use crate::colmap::database::{Image, VerifiedPair};
 use serde::Serialize;
 
 /// One edge: vertex indices `i < j` and the verified pair it came from.

@@ -5,12 +5,12 @@
 //! (`vgsel_runs.parameters`; the defaults if it was never pruned) and reads kept/removed from the
 //! database itself: an edge is removed when its original row is in `vgsel_backup`.
 
+use crate::colmap::database::{pair_id, Database, SqlResult};
+use crate::colmap::rewrite;
 use crate::costs::CostModel;
-use crate::database::{pair_id, Database, SqlResult};
-use crate::overrides::Overrides;
-use crate::prune::{self, Plan};
-use crate::rewrite;
-use crate::search::FlowRule;
+use crate::flow::search::FlowRule;
+use crate::selection::overrides::Overrides;
+use crate::selection::pipeline::{self, Plan};
 use anyhow::{Context, Result};
 use std::collections::{BTreeMap, HashSet};
 use std::fmt::Write;
@@ -76,13 +76,13 @@ pub fn export(db: &Database, format: Format) -> Result<(String, Exported)> {
             min_num_matches = n as usize;
         }
     }
-    let options = prune::Options {
+    let options = pipeline::Options {
         min_num_matches,
         rule: FlowRule::Fixed(0),
         model: CostModel::general(),
         unweighted_priors: true,
     };
-    let plan = prune::plan_with(db, &options, &Overrides::default(), &|_| {})?;
+    let plan = pipeline::plan_with(db, &options, &Overrides::default(), &|_| {})?;
     let removed = removed_pair_ids(db)?;
     let graph = build(&plan, &removed);
     let exported = Exported {

@@ -5,7 +5,7 @@
 //! fit; [`umeyama_ransac`] makes it robust to a few badly placed cameras, so one wrong image
 //! does not hide how good the rest is.
 
-use crate::model::ModelImage;
+use crate::colmap::model::ModelImage;
 use anyhow::{bail, ensure, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rand::seq::index::sample;

@@ -1,6 +1,6 @@
 //! Relative poses of verified pairs from the geometry COLMAP stored, through OpenCV's calib3d.
 //!
-//! Everything works on undistorted normalised coordinates ([`crate::camera`]), so one identity
+//! Everything works on undistorted normalised coordinates ([`crate::geometry::camera`]), so one identity
 //! calibration serves every camera model. The pose of a pair comes from its stored matrix chosen
 //! by COLMAP's config (E for CALIBRATED, E = K2ᵀ F K1 for UNCALIBRATED, H for planar or
 //! panoramic), decomposed with `recoverPose` on the inliers. A stored matrix that most inliers do

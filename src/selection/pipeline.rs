@@ -1,13 +1,13 @@
 //! The prune pipeline up to the selection: read the database, build the view graph, compute the
-//! priors and costs, run the flow search. It writes nothing; [`crate::rewrite`] applies the plan.
+//! priors and costs, run the flow search. It writes nothing; [`crate::colmap::rewrite`] applies the plan.
 
+use crate::colmap::database::{pair_id, Database, Image, VerifiedPair};
 use crate::costs::{self, CostModel, Costs};
-use crate::database::{pair_id, Database, Image, VerifiedPair};
-use crate::overrides::{EdgeRule, Listed, Network, Overrides};
+use crate::flow::search::{self, FlowRule, SearchResult};
 use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, Inputs, PriorValues};
-use crate::search::{self, FlowRule, SearchResult};
-use crate::view_graph::ViewGraph;
+use crate::scene::view_graph::ViewGraph;
+use crate::selection::overrides::{EdgeRule, Listed, Network, Overrides};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -75,7 +75,7 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
     plan_with(db, options, &Overrides::default(), stage)
 }
 
-/// [`plan`] honouring user overrides (see [`crate::overrides`]).
+/// [`plan`] honouring user overrides (see [`crate::selection::overrides`]).
 pub fn plan_with(
     db: &Database,
     options: &Options,
@@ -220,7 +220,7 @@ pub fn fitness_floor(options: &Options, graph: &ViewGraph, pair_costs: &[f64]) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::search::Criteria;
+    use crate::flow::search::Criteria;
 
     #[test]
     fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {
