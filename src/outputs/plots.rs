@@ -5,7 +5,7 @@ use crate::progress::Progress;
 use crate::selection::pipeline::Plan;
 use anyhow::{anyhow, Context, Result};
 use plotters::prelude::*;
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Images per axis above which the match matrix bins images, to keep the SVG small.
@@ -140,7 +140,8 @@ fn match_matrix(plan: &Plan, path: &Path) -> Result<()> {
     let n = ids.len().max(1);
     let bins = n.min(MAX_CELLS);
     let bin = |id: u32| ids.binary_search(&id).map_or(0, |k| k * bins / n);
-    let mut cells: HashMap<(usize, usize), Cell> = HashMap::new();
+    // Ordered, so the SVG is the same file on every run.
+    let mut cells: BTreeMap<(usize, usize), Cell> = BTreeMap::new();
     let mut mark = |a: u32, b: u32, cell: Cell| {
         let (x, y) = (bin(a), bin(b));
         for key in [(x, y), (y, x)] {

@@ -15,7 +15,7 @@
 use super::overlap::convex_hull;
 use super::{Inputs, PriorValues};
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeMap, HashSet};
 
 /// Each vertex's matched keypoints with the vertices they match, sorted by keypoint.
 fn matched_features(inputs: &Inputs) -> Vec<Vec<(u32, u32)>> {
@@ -31,7 +31,8 @@ fn matched_features(inputs: &Inputs) -> Vec<Vec<(u32, u32)>> {
     out
 }
 
-type Context = HashMap<u32, f64>;
+/// Ordered, so that sums over it run in one order and the prior is the same bit for bit on every run.
+type Context = BTreeMap<u32, f64>;
 
 /// w of vertex `v` in its pair with `other`: features of `v` not in `matched`, kept by `keep`.
 fn context_vector(
