@@ -8,5 +8,5 @@ if command -v python3 >/dev/null && ! python3 -c "import networkx" 2>/dev/null; 
   python3 -m pip install --quiet networkx
 fi
 cargo fmt --check
-cargo clippy --all-targets --quiet -- -D warnings
-cargo test --all-targets
+cargo clippy --workspace --all-targets --quiet -- -D warnings
+cargo test --workspace --all-targets

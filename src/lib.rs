@@ -9,7 +9,7 @@
 pub mod colmap;
 pub mod costs;
 pub mod eval;
-pub mod flow;
+pub use vgsel_flow as flow;
 pub mod geometry;
 pub mod outputs;
 pub mod priors;

@@ -5,7 +5,7 @@
 //! after the last pair line are accepted. Anything else is an error naming the 1-based line.
 //! Duplicate pairs are not detected. [`write`] produces the format, round-tripping costs exactly.
 
-use crate::flow::network::{PairArc, SelectionProblem};
+use crate::network::{PairArc, SelectionProblem};
 use anyhow::{bail, Result};
 use std::fmt::Write as _;
 

@@ -21,8 +21,8 @@
 //! is met at the latest at F = |E|; only zero costs (ties) can prevent it. Images without pairs
 //! never carry flow, so A n above the number of images with pairs caps the search at once.
 
-use crate::flow::network::{Selection, SelectionProblem};
-use crate::flow::solver::ParametricSolver;
+use crate::network::{Selection, SelectionProblem};
+use crate::solver::ParametricSolver;
 use serde::Serialize;
 
 #[derive(Clone, Copy, Debug)]

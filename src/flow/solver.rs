@@ -4,7 +4,7 @@
 //!
 //! [`ParametricSolver`] finds, for every flow value F = 0, 1, 2, ... up to the maximum flow, a
 //! minimum-cost flow of value exactly F on the network of paper section 4 (see
-//! [`crate::flow::network`]): nodes s, in_i, out_i, t; arcs s -> in_i, in_i -> out_i (capacity deg(i),
+//! [`crate::network`]): nodes s, in_i, out_i, t; arcs s -> in_i, in_i -> out_i (capacity deg(i),
 //! cost c_i), out_i -> in_j for pairs i < j (capacity 1, cost c_ij), out_i -> t. The source and
 //! sink arcs have capacity F, which never binds for a flow of value F, so they are treated as
 //! unbounded. The maximum flow is sum_i deg(i) = 2|E| (every unit on its own image arc, no pair).
@@ -51,7 +51,7 @@
 //! Memory: 16 bytes per stored arc plus 24 bytes per node (about 170 MB for 5M pairs).
 //! Capacity limits: fewer than 2^31 stored arcs and 2^31 nodes.
 
-use crate::flow::network::{Selection, SelectionProblem};
+use crate::network::{Selection, SelectionProblem};
 
 /// Multiplier from original costs (in [-1, 0]) to the integer costs the solver works with.
 pub const COST_SCALE: f64 = (1u64 << 30) as f64;

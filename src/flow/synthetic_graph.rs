@@ -3,7 +3,7 @@
 //! it, costs uniform in [-1, 0], labels shuffled as in unordered photo collections. Used by the
 //! solver benchmarks; deterministic from a seed.
 
-use crate::flow::network::{PairArc, SelectionProblem};
+use crate::network::{PairArc, SelectionProblem};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
