@@ -8,6 +8,7 @@
 
 pub mod colmap;
 pub mod costs;
+#[cfg(feature = "eval")]
 pub mod eval;
 pub use vgsel_flow as flow;
 pub mod geometry;

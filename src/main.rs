@@ -64,8 +64,10 @@ enum Command {
     /// Run the selection solver on a plain-text graph (benchmarks, solver-only users).
     Solve(cli::solve::SolveArgs),
     /// Score a reconstruction against ground-truth poses; prints JSON.
+    #[cfg(feature = "eval")]
     Eval(cli::eval::EvalArgs),
     /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
+    #[cfg(feature = "eval")]
     #[command(subcommand)]
     Generate(cli::generate::GenerateCommand),
     /// Write the view graph with each pair's priors, cost and kept/removed, for Graphviz or networkx.
@@ -113,7 +115,9 @@ fn main() -> ExitCode {
         Command::Restore(args) => cli::restore::run(&args, quiet),
         Command::Inspect(args) => cli::inspect::run(&args),
         Command::Solve(args) => cli::solve::run(&args),
+        #[cfg(feature = "eval")]
         Command::Eval(args) => cli::eval::run(&args),
+        #[cfg(feature = "eval")]
         Command::Generate(command) => cli::generate::run(&command),
         Command::Export(args) => cli::export::run(&args, quiet, &progress),
         Command::Completions { shell } => {

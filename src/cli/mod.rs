@@ -6,8 +6,10 @@
 //! [`dashed_aliases`] adds the dashed spelling (`--num-images`) as a visible alias.
 
 pub mod args;
+#[cfg(feature = "eval")]
 pub mod eval;
 pub mod export;
+#[cfg(feature = "eval")]
 pub mod generate;
 pub mod inspect;
 pub mod prune;

@@ -5,4 +5,5 @@ pub mod graph_file;
 pub mod network;
 pub mod search;
 pub mod solver;
+#[cfg(feature = "synthetic")]
 pub mod synthetic_graph;
