@@ -9,7 +9,7 @@ if command -v python3 >/dev/null && ! python3 -c "import networkx" 2>/dev/null; 
 fi
 cargo fmt --check
 # The tool alone builds without the evaluation tooling, and none of its dependencies come along.
-cargo check --quiet --no-default-features --bin vgsel-colmap
+cargo clippy --quiet --no-default-features --bin vgsel-colmap -- -D warnings
 if cargo tree --no-default-features -e normal --prefix none | grep -E '^(png|rand|rand_chacha|rand_distr) '; then
   echo "test.sh: the tool alone depends on the evaluation tooling's crates (above)" >&2
   exit 1

@@ -49,6 +49,8 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+// Parsed once per run: the size of the largest variant costs nothing.
+#[allow(clippy::large_enum_variant)]
 enum Command {
     /// Keep only the selected pairs valid in two_view_geometries (reversible).
     #[command(after_help = "Examples:
