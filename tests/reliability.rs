@@ -299,7 +299,7 @@ impl LockHolder {
             .stdin(std::process::Stdio::piped())
             .stdout(std::process::Stdio::piped())
             .spawn()
-            .expect("running sqlite3 (scripts/install-deps.sh installs it)");
+            .expect("running sqlite3 (scripts/ci/install-deps.sh installs it)");
         let stdin = child.stdin.as_mut().unwrap();
         writeln!(stdin, "{begin}; SELECT 'locked';").unwrap();
         let mut line = String::new();

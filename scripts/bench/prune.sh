@@ -3,10 +3,10 @@
 # (~100K verified pairs, hundreds of inliers each, exhaustive-matcher rows for all 500K pairs),
 # then runs `prune --preset general` on it in place under /usr/bin/time -v, on at most 2 cores,
 # and prints wall time, peak memory and the report's timings (read, priors, solve, write).
-# usage: scripts/bench-prune.sh [--num_images 1000] [--num_points 24000] [--view_cone_degrees 16]
+# usage: scripts/bench/prune.sh [--num_images 1000] [--num_points 24000] [--view_cone_degrees 16]
 # The database is kept in $BENCH_DIR (default target/bench) and reused when its spec is unchanged.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 num_images=1000 num_points=24000 cone=16
 while [ $# -gt 0 ]; do
   case "$1" in

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Runs scripts/pipeline.sh on the real image sets in ../shared/datasets (never copied into the
 # project) and prints a markdown results table; one set at a time, as COLMAP uses both cores.
-# usage: scripts/run-datasets.sh [SET ...]   (default: the small sets; WORK=target/datasets)
+# usage: scripts/tools/run-datasets.sh [SET ...]   (default: the small sets; WORK=target/datasets)
 # environment: DATASETS (default ../shared/datasets), WORK, and everything pipeline.sh reads.
 set -euo pipefail
-here=$(cd "$(dirname "$0")/.." && pwd)
+here=$(cd "$(dirname "$0")/../.." && pwd)
 datasets=${DATASETS:-$here/../shared/datasets}
 work=${WORK:-$here/target/datasets}
 sets=("$@")
@@ -18,7 +18,7 @@ for set in "${sets[@]}"; do
     echo "run-datasets: $set failed (see $work/$set)" >&2
 done
 python3 "$here/scripts/results-table.py" "$work" "${sets[@]}"
-# Sets without ground truth: the written-down ghost check on the camera paths (scripts/topview.py).
+# Sets without ground truth: the written-down ghost check on the camera paths (scripts/tools/topview.py).
 for set in "${sets[@]}"; do
   [ -f "$datasets/$set/gt/colmap_text/images.txt" ] || [ ! -f "$work/$set/summary.json" ] && continue
   python3 "$here/scripts/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How well each prior separates true from false pairs on a real COLMAP database.
 
-usage: scripts/separation.py SCORES.csv LABELS.csv
+usage: scripts/tools/separation.py SCORES.csv LABELS.csv
   SCORES.csv  from `vgsel-colmap prune --scores` (one row per view-graph pair)
   LABELS.csv  from `vgsel-colmap eval --database_path DB --ground_truth GT --labels`
 

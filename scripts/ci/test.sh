@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs every check and test of vgsel-colmap; installs the system packages they need first.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+cd "$(dirname "$0")/../.."
+bash scripts/ci/install-deps.sh
 # networkx: the export test loads the GraphML file with it (skipped where python3 is missing).
 if command -v python3 >/dev/null && ! python3 -c "import networkx" 2>/dev/null; then
   python3 -m pip install --quiet networkx

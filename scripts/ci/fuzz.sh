@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Fuzzes the blob decoders and `solve`'s graph parser with cargo-fuzz (libFuzzer), one target
 # after the other, SECONDS each (default 600), at the lowest CPU priority.
-# Usage: bash scripts/fuzz.sh [SECONDS] [TARGET...]   (targets: decode_blobs graph_parse)
+# Usage: bash scripts/ci/fuzz.sh [SECONDS] [TARGET...]   (targets: decode_blobs graph_parse)
 # cargo-fuzz needs nightly -Z flags; RUSTC_BOOTSTRAP=1 lets the stable toolchain accept them.
 # No sanitizer (-s none): the targets are safe Rust, and a panic is what they look for.
 # Crashes land in fuzz/artifacts/TARGET/; turn each into a regression test in tests/.
 set -euo pipefail
-cd "$(dirname "$0")/../fuzz"
+cd "$(dirname "$0")/../../fuzz"
 seconds="${1:-600}"
 shift || true
 targets=("$@")
