@@ -17,9 +17,9 @@ for set in "${sets[@]}"; do
   bash "$here/scripts/pipeline.sh" "$datasets/$set/images" "$work/$set" $gt >&2 ||
     echo "run-datasets: $set failed (see $work/$set)" >&2
 done
-python3 "$here/scripts/results-table.py" "$work" "${sets[@]}"
+python3 "$here/scripts/tools/results-table.py" "$work" "${sets[@]}"
 # Sets without ground truth: the written-down ghost check on the camera paths (scripts/tools/topview.py).
 for set in "${sets[@]}"; do
   [ -f "$datasets/$set/gt/colmap_text/images.txt" ] || [ ! -f "$work/$set/summary.json" ] && continue
-  python3 "$here/scripts/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"
+  python3 "$here/scripts/tools/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"
 done
