@@ -9,9 +9,7 @@
 //! VGSEL_CRASH_RUNS (default 20) and VGSEL_CRASH_IMAGES (default 40) make longer runs; see
 //! scripts/ci/crash-test.sh.
 
-mod common;
-
-use common::{dump, schema, table_names, Row};
+use crate::support::{dump, schema, table_names, Row};
 use rand::{Rng, SeedableRng};
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};

@@ -2,9 +2,7 @@
 //! error line naming the problem and exit status 1 (or behaves as documented), never panics, and
 //! leaves every file in the database's directory byte for byte as it was whenever it fails.
 
-mod common;
-
-use common::{dump, exec, fixture, ok, scene, table_names, vgsel, Layout};
+use crate::support::{dump, exec, fixture, ok, scene, table_names, vgsel, Layout};
 use rusqlite::Connection;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

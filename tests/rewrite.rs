@@ -1,8 +1,6 @@
 //! The reversible rewrite: exact invalidation, idempotence, restore byte for byte, rollback.
 
-mod common;
-
-use common::*;
+use crate::support::*;
 use rusqlite::types::Value;
 use rusqlite::Connection;
 use std::path::Path;

@@ -2,9 +2,7 @@
 //! pair list, the graph exports (checked by Graphviz and networkx when installed), the overrides,
 //! progress output, completions and the man page.
 
-mod common;
-
-use common::{ok, scene, vgsel};
+use crate::support::{ok, scene, vgsel};
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use tempfile::TempDir;
 use vgsel_colmap::colmap::database::pair_id;
 
-pub const COLMAP_38_SQL: &str = include_str!("../../sql/colmap-3.8.sql");
-pub const COLMAP_LATEST_SQL: &str = include_str!("../../sql/colmap-latest.sql");
+pub const COLMAP_38_SQL: &str = include_str!("../sql/colmap-3.8.sql");
+pub const COLMAP_LATEST_SQL: &str = include_str!("../sql/colmap-latest.sql");
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Layout {
