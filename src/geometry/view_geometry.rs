@@ -1,11 +1,11 @@
-//! The geometric inputs of the pose-based priors: each vertex's camera model and undistorted
+//! The geometric scene of the pose-based priors: each vertex's camera model and undistorted
 //! normalised keypoints, and each edge's relative pose ([`crate::geometry::pose::pair_pose`]).
 //! Computed once per prune, in parallel over images and pairs.
 
 use crate::colmap::database::TwoViewGeometry;
 use crate::geometry::camera::CameraModel;
 use crate::geometry::pose::{pair_pose, RelativePose, StoredGeometry};
-use crate::priors::Inputs;
+use crate::scene::Scene;
 use anyhow::{Context, Result};
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -28,9 +28,9 @@ pub struct ViewGeometry {
 
 impl ViewGeometry {
     /// Normalised inlier coordinates of an edge, oriented i -> j.
-    pub fn edge_points(&self, inputs: &Inputs, edge: usize) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
-        let e = &inputs.graph.edges[edge];
-        inputs
+    pub fn edge_points(&self, scene: &Scene, edge: usize) -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {
+        let e = &scene.graph.edges[edge];
+        scene
             .edge_inliers(edge)
             .map(|[a, b]| {
                 (
@@ -42,8 +42,8 @@ impl ViewGeometry {
     }
 
     /// Epipolar threshold of an edge in normalised units.
-    pub fn threshold(&self, inputs: &Inputs, edge: usize) -> f64 {
-        let e = &inputs.graph.edges[edge];
+    pub fn threshold(&self, scene: &Scene, edge: usize) -> f64 {
+        let e = &scene.graph.edges[edge];
         let f = self.cameras[e.i as usize]
             .focal()
             .min(self.cameras[e.j as usize].focal());
@@ -54,7 +54,7 @@ impl ViewGeometry {
 /// Normalises every vertex's keypoints and recovers every edge's pose. `geometries` holds each
 /// edge's stored two-view geometry (None when the database has none for it).
 pub fn compute(
-    inputs: &Inputs,
+    scene: &Scene,
     cameras: Vec<CameraModel>,
     geometries: &[Option<&TwoViewGeometry>],
 ) -> Result<ViewGeometry> {
@@ -63,8 +63,8 @@ pub fn compute(
     opencv::core::set_num_threads(1)?;
     let normalised = cameras
         .par_iter()
-        .zip(&inputs.keypoints)
-        .zip(&inputs.graph.image_ids)
+        .zip(&scene.keypoints)
+        .zip(&scene.graph.image_ids)
         .map(|((c, kp), id)| {
             c.normalise(kp)
                 .with_context(|| format!("undistorting the keypoints of image {id}"))
@@ -77,7 +77,7 @@ pub fn compute(
         homographies: Vec::new(),
     };
     let m3 = |m: Option<[f64; 9]>| m.map(|a| Matrix3::from_row_slice(&a));
-    geometry.homographies = inputs
+    geometry.homographies = scene
         .graph
         .edges
         .iter()
@@ -88,11 +88,11 @@ pub fn compute(
             Some(k2_inv * h * geometry.cameras[e.i as usize].k())
         })
         .collect();
-    geometry.poses = (0..inputs.graph.edges.len())
+    geometry.poses = (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
-            let e = &inputs.graph.edges[edge];
-            let (x1, x2) = geometry.edge_points(inputs, edge);
+            let e = &scene.graph.edges[edge];
+            let (x1, x2) = geometry.edge_points(scene, edge);
             let stored = geometries[edge];
             let g = StoredGeometry {
                 config: stored.map_or(0, |s| s.config),
@@ -103,12 +103,12 @@ pub fn compute(
                 k2: geometry.cameras[e.j as usize].k(),
                 x1: &x1,
                 x2: &x2,
-                threshold: geometry.threshold(inputs, edge),
+                threshold: geometry.threshold(scene, edge),
             };
             pair_pose(&g).with_context(|| {
                 format!(
                     "relative pose of pair ({}, {})",
-                    inputs.graph.image_ids[e.i as usize], inputs.graph.image_ids[e.j as usize]
+                    scene.graph.image_ids[e.i as usize], scene.graph.image_ids[e.j as usize]
                 )
             })
         })

@@ -1,12 +1,13 @@
 //! The prune pipeline up to the selection: read the database, build the view graph, compute the
 //! priors and costs, run the flow search. It writes nothing; [`crate::colmap::rewrite`] applies the plan.
 
-use crate::colmap::database::{pair_id, Database, Image, VerifiedPair};
+use crate::colmap::database::{pair_id, Camera, Database, Image, TwoViewGeometry, VerifiedPair};
 use crate::costs::{self, CostModel, Costs};
 use crate::flow::search::{self, FlowRule, SearchResult};
 use crate::priors::pairs::FocalEstimate;
-use crate::priors::{self, Inputs, PriorValues};
+use crate::priors::{self, PriorValues};
 use crate::scene::view_graph::ViewGraph;
+use crate::scene::Scene;
 use crate::selection::overrides::{EdgeRule, Listed, Network, Overrides};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
@@ -87,11 +88,7 @@ pub fn plan_with(
 
     stage("reading images and verified pairs");
     let images = db.images()?;
-    let cameras: HashMap<u32, (u32, u32)> = db
-        .cameras()?
-        .into_iter()
-        .map(|c| (c.camera_id, (c.width, c.height)))
-        .collect();
+    let cameras = db.cameras()?;
     let pairs = db.verified_pairs()?;
     if pairs.is_empty() {
         bail!("no verified image pairs in two_view_geometries: run a COLMAP matcher first");
@@ -104,41 +101,14 @@ pub fn plan_with(
         );
     }
     let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
-    let camera_of: HashMap<u32, u32> = images
-        .iter()
-        .map(|im| (im.image_id, im.camera_id))
-        .collect();
-    let image_sizes = graph
-        .image_ids
-        .iter()
-        .map(|id| {
-            let camera = camera_of[id];
-            cameras
-                .get(&camera)
-                .copied()
-                .with_context(|| format!("image {id} names camera {camera}, which does not exist"))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    stage("reading keypoints");
-    let keypoints = graph
-        .image_ids
-        .iter()
-        .map(|&id| db.keypoints_xy(id))
-        .collect::<Result<Vec<_>>>()?;
+    let names = options.model.pair_prior_names(options.unweighted_priors);
+    let scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
     timings.read = started.elapsed().as_secs_f64();
 
     stage("computing priors");
     let t = Instant::now();
-    let inputs = Inputs {
-        graph: &graph,
-        pairs: &pairs,
-        keypoints,
-        image_sizes,
-    };
-    let image_priors = priors::general_image_priors(&inputs);
-    let camera_ids: Vec<u32> = graph.image_ids.iter().map(|id| camera_of[id]).collect();
-    let names = options.model.pair_prior_names(options.unweighted_priors);
-    let pair_priors = priors::pairs::compute(db, &inputs, &camera_ids, &names, stage)?;
+    let image_priors = priors::general_image_priors(&scene);
+    let pair_priors = priors::pairs::compute(&scene, &names, stage)?;
     let costs = costs::compute(&options.model, &image_priors, &pair_priors.values);
     timings.priors = t.elapsed().as_secs_f64();
 
@@ -181,6 +151,74 @@ pub fn plan_with(
         invalidate,
         timings,
     })
+}
+
+/// Reads what the priors `names` need of the database into a [`Scene`] of `graph`: keypoints
+/// and image sizes always; cameras and stored geometries for the pose priors; raw matches for
+/// multiple motions. The only place the priors' inputs come from the database.
+fn load_scene<'a>(
+    db: &Database,
+    graph: &'a ViewGraph,
+    pairs: &'a [VerifiedPair],
+    images: &[Image],
+    cameras: Vec<Camera>,
+    names: &[&str],
+    stage: &dyn Fn(&str),
+) -> Result<Scene<'a>> {
+    let camera_of: HashMap<u32, u32> = images
+        .iter()
+        .map(|im| (im.image_id, im.camera_id))
+        .collect();
+    let camera_ids: Vec<u32> = graph.image_ids.iter().map(|id| camera_of[id]).collect();
+    let sizes: HashMap<u32, (u32, u32)> = cameras
+        .iter()
+        .map(|c| (c.camera_id, (c.width, c.height)))
+        .collect();
+    let image_sizes = graph
+        .image_ids
+        .iter()
+        .zip(&camera_ids)
+        .map(|(id, camera)| {
+            sizes
+                .get(camera)
+                .copied()
+                .with_context(|| format!("image {id} names camera {camera}, which does not exist"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    stage("reading keypoints");
+    let keypoints = graph
+        .image_ids
+        .iter()
+        .map(|&id| db.keypoints_xy(id))
+        .collect::<Result<Vec<_>>>()?;
+    let mut scene = Scene::new(graph, pairs, keypoints, image_sizes);
+    let needs = priors::pairs::needs(names);
+    if needs.geometry {
+        scene.cameras = cameras
+            .into_iter()
+            .filter(|c| camera_ids.contains(&c.camera_id))
+            .collect();
+        let mut stored: HashMap<(u32, u32), TwoViewGeometry> = db
+            .geometries()?
+            .into_iter()
+            .map(|g| ((g.image_id1, g.image_id2), g))
+            .collect();
+        scene.geometries = graph
+            .edges
+            .iter()
+            .map(|e| stored.remove(&(pairs[e.pair].image_id1, pairs[e.pair].image_id2)))
+            .collect();
+    }
+    scene.camera_ids = camera_ids;
+    if needs.matches {
+        stage("reading raw matches");
+        scene.matches = graph
+            .edges
+            .iter()
+            .map(|e| db.matches(graph.image_ids[e.i as usize], graph.image_ids[e.j as usize]))
+            .collect::<Result<Vec<_>>>()?;
+    }
+    Ok(scene)
 }
 
 /// The cost model's `min_pair_fitness`, lowered where needed so that the image criterion's
