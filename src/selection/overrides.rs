@@ -1,8 +1,8 @@
 //! User overrides of the selection: pairs always kept (`--keep_pairs`), pairs and images never
 //! selected (`--forbid_pairs`, `--forbid_images`).
 //!
-//! Overrides change the network, never the costs, so the result stays an exact min-cost flow and
-//! is easy to explain:
+//! Overrides change the network ([`crate::flow::network::SelectionProblem::restrict`]), never
+//! the costs, so the result stays an exact min-cost flow and is easy to explain:
 //! - a forbidden image leaves the network with all its pairs; the search criteria count only the
 //!   images that remain;
 //! - a forbidden pair's arc leaves the network;
@@ -15,8 +15,7 @@
 //! starting with `#` are skipped.
 
 use crate::colmap::database::Image;
-use crate::costs::Costs;
-use crate::flow::network::{PairArc, Selection, SelectionProblem};
+use crate::flow::network::ArcRule;
 use crate::scene::view_graph::ViewGraph;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
@@ -72,14 +71,6 @@ pub struct Overrides {
     pub forbid_images: Option<NameList>,
 }
 
-/// What each view-graph edge is subject to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum EdgeRule {
-    Free,
-    Kept,
-    Forbidden,
-}
-
 /// The overrides as listed in the report, by image name.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Listed {
@@ -96,7 +87,7 @@ pub struct Listed {
 #[derive(Clone, Debug)]
 pub struct Resolved {
     /// Indexed like `ViewGraph::edges`.
-    pub edges: Vec<EdgeRule>,
+    pub edges: Vec<ArcRule>,
     /// Indexed like `ViewGraph::image_ids`.
     pub forbidden_vertices: Vec<bool>,
     pub listed: Listed,
@@ -148,7 +139,7 @@ impl Overrides {
             })
         };
 
-        let mut edges = vec![EdgeRule::Free; graph.edges.len()];
+        let mut edges = vec![ArcRule::Free; graph.edges.len()];
         let mut forbidden_vertices = vec![false; graph.num_vertices()];
         let mut listed = Listed::default();
         if let Some(list) = &self.forbid_images {
@@ -161,14 +152,14 @@ impl Overrides {
         }
         for (k, e) in graph.edges.iter().enumerate() {
             if forbidden_vertices[e.i as usize] || forbidden_vertices[e.j as usize] {
-                edges[k] = EdgeRule::Forbidden;
+                edges[k] = ArcRule::Removed;
                 listed.pairs_of_forbidden_images += 1;
             }
         }
         if let Some(list) = &self.forbid_pairs {
             for (line, names) in &list.entries {
                 match edge_of(list, *line, names)? {
-                    Some(k) => edges[k] = EdgeRule::Forbidden,
+                    Some(k) => edges[k] = ArcRule::Removed,
                     None => listed.forbid_pairs_not_in_view_graph += 1,
                 }
                 listed
@@ -185,13 +176,13 @@ impl Overrides {
                         names[0], names[1]
                     );
                 };
-                if edges[k] == EdgeRule::Forbidden {
+                if edges[k] == ArcRule::Removed {
                     bail!(
                         "{where_}: `{}` `{}` is kept but also forbidden (--forbid_pairs or --forbid_images)",
                         names[0], names[1]
                     );
                 }
-                edges[k] = EdgeRule::Kept;
+                edges[k] = ArcRule::Fixed;
                 listed.keep_pairs.push([names[0].clone(), names[1].clone()]);
             }
         }
@@ -200,77 +191,5 @@ impl Overrides {
             forbidden_vertices,
             listed,
         })
-    }
-}
-
-/// The flow network left after the overrides, and how to read its selection back on the whole
-/// view graph.
-#[derive(Clone, Debug)]
-pub struct Network {
-    pub problem: SelectionProblem,
-    /// View-graph vertex of each network image (ascending, so pair arcs keep their orientation).
-    vertex_of: Vec<u32>,
-    /// View-graph edge of each network pair.
-    edge_of: Vec<usize>,
-    rules: Vec<EdgeRule>,
-    forbidden_vertices: Vec<bool>,
-}
-
-impl Network {
-    pub fn new(graph: &ViewGraph, costs: &Costs, resolved: &Resolved) -> Network {
-        let mut index = vec![u32::MAX; graph.num_vertices()];
-        let mut vertex_of = Vec::new();
-        let mut image_costs = Vec::new();
-        for (v, &forbidden) in resolved.forbidden_vertices.iter().enumerate() {
-            if !forbidden {
-                index[v] = vertex_of.len() as u32;
-                vertex_of.push(v as u32);
-                image_costs.push(costs.image_costs[v]);
-            }
-        }
-        let mut pairs = Vec::new();
-        let mut edge_of = Vec::new();
-        for (k, e) in graph.edges.iter().enumerate() {
-            if resolved.edges[k] == EdgeRule::Free {
-                pairs.push(PairArc {
-                    i: index[e.i as usize],
-                    j: index[e.j as usize],
-                    cost: costs.pair_costs[k],
-                });
-                edge_of.push(k);
-            }
-        }
-        Network {
-            problem: SelectionProblem { image_costs, pairs },
-            vertex_of,
-            edge_of,
-            rules: resolved.edges.clone(),
-            forbidden_vertices: resolved.forbidden_vertices.clone(),
-        }
-    }
-
-    /// The network's selection on the whole view graph: plus the kept pairs and their images,
-    /// forbidden images and pairs never selected. Flow and cost stay the network's.
-    pub fn expand(&self, graph: &ViewGraph, selection: &Selection) -> Selection {
-        let mut images = vec![false; self.forbidden_vertices.len()];
-        for (k, &v) in self.vertex_of.iter().enumerate() {
-            images[v as usize] = selection.images[k];
-        }
-        let mut pairs: Vec<bool> = self.rules.iter().map(|&r| r == EdgeRule::Kept).collect();
-        for (k, &e) in self.edge_of.iter().enumerate() {
-            pairs[e] = selection.pairs[k];
-        }
-        for (e, rule) in graph.edges.iter().zip(&self.rules) {
-            if *rule == EdgeRule::Kept {
-                images[e.i as usize] = true;
-                images[e.j as usize] = true;
-            }
-        }
-        Selection {
-            flow: selection.flow,
-            images,
-            pairs,
-            cost: selection.cost,
-        }
     }
 }

@@ -3,12 +3,13 @@
 
 use crate::colmap::database::{pair_id, Camera, Database, Image, TwoViewGeometry, VerifiedPair};
 use crate::costs::{self, CostModel, Costs};
+use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
 use crate::flow::search::{self, FlowRule, SearchResult};
 use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::Scene;
-use crate::selection::overrides::{EdgeRule, Listed, Network, Overrides};
+use crate::selection::overrides::{Listed, Overrides};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -46,7 +47,7 @@ pub struct Plan {
     /// Focal lengths estimated where the database had only a guess.
     pub focal_estimates: Vec<FocalEstimate>,
     /// The network the flow ran on (the view graph less the overrides' arcs).
-    pub network: Network,
+    pub network: Restriction,
     pub overrides: Listed,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
@@ -117,14 +118,14 @@ pub fn plan_with(
     let floor = fitness_floor(options, &graph, &costs.pair_costs);
     let mut below_fitness_floor = 0;
     for (rule, cost) in resolved.edges.iter_mut().zip(&costs.pair_costs) {
-        if *rule == EdgeRule::Free && -cost < floor {
-            *rule = EdgeRule::Forbidden;
+        if *rule == ArcRule::Free && -cost < floor {
+            *rule = ArcRule::Removed;
             below_fitness_floor += 1;
         }
     }
-    let network = Network::new(&graph, &costs, &resolved);
+    let network = problem(&graph, &costs).restrict(&resolved.forbidden_vertices, &resolved.edges);
     let mut search = search::search(&network.problem, &options.rule);
-    search.selection = network.expand(&graph, &search.selection);
+    search.selection = network.expand(&search.selection);
     timings.solve = t.elapsed().as_secs_f64();
 
     let invalidate = graph
@@ -151,6 +152,24 @@ pub fn plan_with(
         invalidate,
         timings,
     })
+}
+
+/// The paper's network on the whole view graph: vertices and edges in view-graph order (image_id
+/// order, which orients the pair arcs).
+fn problem(graph: &ViewGraph, costs: &Costs) -> SelectionProblem {
+    SelectionProblem {
+        image_costs: costs.image_costs.clone(),
+        pairs: graph
+            .edges
+            .iter()
+            .zip(&costs.pair_costs)
+            .map(|(e, &cost)| PairArc {
+                i: e.i,
+                j: e.j,
+                cost,
+            })
+            .collect(),
+    }
 }
 
 /// Reads what the priors `names` need of the database into a [`Scene`] of `graph`: keypoints
