@@ -12,37 +12,43 @@ use crate::colmap::database::{
 };
 use anyhow::{anyhow, bail, Result};
 use rusqlite::{Connection, OpenFlags, Transaction, TransactionBehavior};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
 use std::collections::BTreeSet;
 use std::path::Path;
 
 /// The project's tables (CREATE TABLE IF NOT EXISTS).
 pub const VGSEL_SQL: &str = include_str!("../../sql/vgsel.sql");
 
-/// What a prune records in the project's runs table.
-#[derive(Clone, Debug)]
-pub struct RunRecord {
-    /// JSON of the parameters used.
-    pub parameters: String,
+/// What a prune records in the project's runs table: its parameters `P` (stored as JSON with
+/// sorted keys; this layer does not know what they mean) and what it selected.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunRecord<P> {
+    /// The parameters the prune ran with.
+    pub parameters: P,
+    /// The flow F chosen (None where no flow ran).
     pub flow: Option<u64>,
+    /// Images in the database.
     pub images_total: usize,
+    /// Images with a selected pair.
     pub images_selected: usize,
+    /// View-graph edges.
     pub pairs_total: usize,
+    /// Edges left valid.
     pub pairs_selected: usize,
 }
 
-/// A row of vgsel_runs, as read back for reports.
+/// A row of vgsel_runs, as read back.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RunRecordRow {
+pub struct RunRecordRow<P> {
+    /// The row's id: 1 for the first prune, counting up.
     pub run_id: i64,
     /// UTC, ISO-8601 (`2024-05-01T12:00:00Z`).
     pub time: String,
+    /// The vgsel-colmap version that pruned.
     pub tool_version: String,
-    pub parameters: String,
-    pub flow: Option<u64>,
-    pub images_total: usize,
-    pub images_selected: usize,
-    pub pairs_total: usize,
-    pub pairs_selected: usize,
+    /// What it recorded.
+    pub run: RunRecord<P>,
 }
 
 /// Puts every backed-up row back into two_view_geometries (re-inserting rows deleted since the
@@ -85,9 +91,15 @@ fn ensure_writable(db: &Database) -> Result<()> {
 /// Makes exactly the pairs in `invalidate` (pair_ids) invalid, starting from the original rows
 /// (a previous prune is undone first), saves their original rows in the backup table and appends
 /// a run record; all in one transaction.
-pub fn apply(db: &mut Database, invalidate: &[u64], run: &RunRecord) -> Result<()> {
+pub fn apply<P: Serialize>(
+    db: &mut Database,
+    invalidate: &[u64],
+    run: &RunRecord<P>,
+) -> Result<()> {
+    // Through a JSON value, whose maps are sorted: the stored text does not depend on field order.
+    let parameters = serde_json::to_value(&run.parameters)?.to_string();
     write_transaction(db, |tx, columns, p| {
-        apply_in(tx, columns, p, invalidate, run)
+        apply_in(tx, columns, p, invalidate, &parameters, run)
     })
 }
 
@@ -127,12 +139,13 @@ fn settle_after_failure(db: &Database) {
         });
 }
 
-fn apply_in(
+fn apply_in<P>(
     tx: &Transaction,
     columns: &[&'static str],
     p: &Path,
     invalidate: &[u64],
-    run: &RunRecord,
+    parameters: &str,
+    run: &RunRecord<P>,
 ) -> Result<()> {
     tx.execute_batch(VGSEL_SQL).sql(p)?;
     put_back(tx, columns).sql(p)?;
@@ -184,7 +197,7 @@ fn apply_in(
          VALUES (strftime('%Y-%m-%dT%H:%M:%SZ', 'now'), ?1, ?2, ?3, ?4, ?5, ?6, ?7)",
         rusqlite::params![
             env!("CARGO_PKG_VERSION"),
-            run.parameters,
+            parameters,
             run.flow.map(|f| f as i64),
             count(run.images_total),
             count(run.images_selected),
@@ -212,7 +225,7 @@ pub fn restore(db: &mut Database) -> Result<usize> {
 
 /// The most recent prune's record, or None when the database has no runs table (never pruned,
 /// or restored since).
-pub fn last_run(db: &Database) -> Result<Option<RunRecordRow>> {
+pub fn last_run<P: DeserializeOwned>(db: &Database) -> Result<Option<RunRecordRow<P>>> {
     let p = db.path();
     let conn = db.conn();
     if !table_exists(conn, "vgsel_runs").sql(p)? {
@@ -229,16 +242,26 @@ pub fn last_run(db: &Database) -> Result<Option<RunRecordRow>> {
         return Ok(None);
     };
     let n = |i: usize| -> Result<usize> { Ok(r.get::<_, i64>(i).sql(p)? as usize) };
+    let run_id: i64 = r.get(0).sql(p)?;
+    let text: String = r.get(3).sql(p)?;
+    let parameters = serde_json::from_str(&text).map_err(|e| {
+        anyhow!(
+            "{}: vgsel_runs row {run_id}: parameters this version cannot read ({e}); restore and prune again",
+            p.display()
+        )
+    })?;
     Ok(Some(RunRecordRow {
-        run_id: r.get(0).sql(p)?,
+        run_id,
         time: r.get(1).sql(p)?,
         tool_version: r.get(2).sql(p)?,
-        parameters: r.get(3).sql(p)?,
-        flow: r.get::<_, Option<i64>>(4).sql(p)?.map(|f| f as u64),
-        images_total: n(5)?,
-        images_selected: n(6)?,
-        pairs_total: n(7)?,
-        pairs_selected: n(8)?,
+        run: RunRecord {
+            parameters,
+            flow: r.get::<_, Option<i64>>(4).sql(p)?.map(|f| f as u64),
+            images_total: n(5)?,
+            images_selected: n(6)?,
+            pairs_total: n(7)?,
+            pairs_selected: n(8)?,
+        },
     }))
 }
 

@@ -31,6 +31,25 @@ pub enum FlowRule {
     Criteria(Criteria),
 }
 
+impl FlowRule {
+    /// A fixed flow when `flow` is set, else the criteria, each taken from `defaults` (image
+    /// fraction, pairs per image) where unset.
+    pub fn new(
+        flow: Option<u64>,
+        min_image_fraction: Option<f64>,
+        min_pairs_per_image: Option<f64>,
+        defaults: (f64, f64),
+    ) -> FlowRule {
+        match flow {
+            Some(f) => FlowRule::Fixed(f),
+            None => FlowRule::Criteria(Criteria {
+                min_image_fraction: min_image_fraction.unwrap_or(defaults.0),
+                min_pairs_per_image: min_pairs_per_image.unwrap_or(defaults.1),
+            }),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Criteria {
     /// Selected images / images in the view graph.

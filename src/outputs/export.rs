@@ -2,16 +2,19 @@
 //! kept pairs as a COLMAP pair list (`prune --pairs_out`).
 //!
 //! `export` recomputes the priors and costs with the parameters of the database's last prune
-//! (`vgsel_runs.parameters`; the defaults if it was never pruned) and reads kept/removed from the
-//! database itself: an edge is removed when its original row is in `vgsel_backup`.
+//! (its typed run record: preset, cost model with any weight overrides, `min_num_matches`; the
+//! general preset's if it was never pruned), so the costs shown are the ones that drove the
+//! selection, and reads kept/removed from the database itself: an edge is removed when its
+//! original row is in `vgsel_backup`.
 
 use crate::colmap::database::{pair_id, Database, SqlResult};
 use crate::colmap::rewrite;
-use crate::costs::CostModel;
 use crate::flow::search::FlowRule;
 use crate::selection::overrides::Overrides;
-use crate::selection::pipeline::{self, Plan};
-use anyhow::{Context, Result};
+use crate::selection::parameters::Parameters;
+use crate::selection::pipeline::{self, Plan, DEFAULT_MIN_NUM_MATCHES};
+use crate::selection::preset::Preset;
+use anyhow::Result;
 use std::collections::{BTreeMap, HashSet};
 use std::fmt::Write;
 
@@ -68,19 +71,14 @@ pub struct Exported {
 
 /// Reads `db` (never writes it) and returns the file contents in `format`.
 pub fn export(db: &Database, format: Format) -> Result<(String, Exported)> {
-    let mut min_num_matches = 15;
-    if let Some(run) = rewrite::last_run(db)? {
-        let parameters: serde_json::Value = serde_json::from_str(&run.parameters)
-            .with_context(|| format!("vgsel_runs row {}: parameters are not JSON", run.run_id))?;
-        if let Some(n) = parameters["min_num_matches"].as_u64() {
-            min_num_matches = n as usize;
-        }
-    }
+    let parameters = match rewrite::last_run::<Parameters>(db)? {
+        Some(row) => row.run.parameters,
+        None => Parameters::of_preset(Preset::General, DEFAULT_MIN_NUM_MATCHES),
+    };
+    // The costs only: which pairs were kept is read from the database, so no flow runs.
     let options = pipeline::Options {
-        min_num_matches,
         rule: FlowRule::Fixed(0),
-        model: CostModel::general(),
-        unweighted_priors: true,
+        ..parameters.options(true)
     };
     let plan = pipeline::plan_with(db, &options, &Overrides::default(), &|_| {})?;
     let removed = removed_pair_ids(db)?;

@@ -3,6 +3,7 @@
 use crate::flow::search::CriterionStatus;
 use crate::scene::view_graph::{GraphStats, ViewGraph};
 use crate::selection::overrides::Listed;
+use crate::selection::parameters::Parameters;
 use crate::selection::pipeline::{Plan, Timings};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -72,7 +73,7 @@ impl Report {
         plan: &Plan,
         database_path: String,
         output_path: Option<String>,
-        parameters: serde_json::Value,
+        parameters: &Parameters,
     ) -> Report {
         let selection = &plan.search.selection;
         let after = ViewGraph::build(&plan.images, &plan.selected_pairs(), 1);
@@ -121,7 +122,7 @@ impl Report {
             dry_run: output_path.is_none(),
             database_path,
             output_path,
-            parameters,
+            parameters: serde_json::to_value(parameters).expect("parameters serialise"),
             flow: selection.flow,
             capped: plan.search.capped,
             images_total: plan.images.len(),

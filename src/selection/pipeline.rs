@@ -15,6 +15,10 @@ use serde::Serialize;
 use std::collections::HashMap;
 use std::time::Instant;
 
+/// COLMAP's default `--Mapper.min_num_matches`: fewer verified inliers make no view-graph edge.
+pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;
+
+/// What the pipeline runs with (built from [`crate::selection::parameters::Parameters`]).
 pub struct Options {
     pub min_num_matches: usize,
     pub rule: FlowRule,

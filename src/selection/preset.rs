@@ -1,0 +1,46 @@
+//! The presets: each is a cost model (which priors, their g and weights, the fitness floor) and
+//! the flow-search criteria that go with it, in one place.
+
+use crate::costs::CostModel;
+use clap::ValueEnum;
+use serde::{Deserialize, Serialize};
+
+/// A named choice of cost model and search criteria (`prune --preset`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Preset {
+    /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
+    /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
+    General,
+    /// For scenes with duplicate or symmetric structure: pair priors loop consistency (rotations
+    /// and translations of every triangle) and unique tracks, pairs below fitness 0.6 never
+    /// selected; the paper's context and multiple motions at weight 0 (in --scores). Search: 80%
+    /// of images, 5 pairs per image.
+    Disambiguation,
+}
+
+impl Preset {
+    /// The preset's name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::General => "general",
+            Preset::Disambiguation => "disambiguation",
+        }
+    }
+
+    /// Which priors make the costs, with their g and weights, and the fitness floor.
+    pub fn model(self) -> CostModel {
+        match self {
+            Preset::General => CostModel::general(),
+            Preset::Disambiguation => CostModel::disambiguation(),
+        }
+    }
+
+    /// The paper's flow-search criteria: (image fraction, pairs per image).
+    pub fn criteria(self) -> (f64, f64) {
+        match self {
+            Preset::General => (0.9, 20.0),
+            Preset::Disambiguation => (0.8, 5.0),
+        }
+    }
+}
