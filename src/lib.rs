@@ -14,6 +14,5 @@ pub use vgsel_flow as flow;
 pub mod geometry;
 pub mod outputs;
 pub mod priors;
-pub mod progress;
 pub mod scene;
 pub mod selection;

@@ -2,9 +2,9 @@
 
 mod cli;
 
+use crate::cli::progress::Progress;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
-use vgsel_colmap::progress::Progress;
 
 const EXAMPLES: &str = "\
 Examples:

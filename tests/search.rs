@@ -4,7 +4,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashSet;
 use vgsel_colmap::flow::network::{PairArc, Selection, SelectionProblem};
-use vgsel_colmap::flow::search::{search, targets, Criteria, FlowRule, SearchResult};
+use vgsel_colmap::flow::search::{
+    search, search_with_curve, targets, Criteria, FlowRule, SearchResult,
+};
 use vgsel_colmap::flow::solver::{solve, ParametricSolver};
 
 fn random_problem(n: usize, m: usize, seed: u64) -> SelectionProblem {
@@ -190,4 +192,39 @@ fn degenerate_inputs() {
     assert!(!status(&r, "images").binding && !status(&r, "pairs").binding);
     let r = search(&lonely, &FlowRule::Fixed(3));
     assert_eq!(r.selection.flow, 0);
+}
+
+#[test]
+fn curve_beyond_the_choice_continues_the_same_flows_and_keeps_the_selection() {
+    for seed in 0..20 {
+        let problem = random_problem(12, 30, seed);
+        for rule in [criteria(0.6, 1.0), FlowRule::Fixed(3), criteria(1.0, 30.0)] {
+            let plain = search(&problem, &rule);
+            let extended = search_with_curve(&problem, &rule, 4);
+            assert_eq!(extended.selection, plain.selection, "seed {seed}");
+            assert_eq!(extended.curve.len(), plain.curve.len());
+            // Every point, chosen or beyond, is what a fresh solver selects at that F.
+            let mut fresh = ParametricSolver::new(&problem);
+            for p in extended.curve.iter().chain(&extended.beyond) {
+                while fresh.flow() < p.flow {
+                    fresh.augment().expect("the search reached this flow");
+                }
+                assert_eq!(
+                    (p.images_selected, p.pairs_selected),
+                    (fresh.images_selected(), fresh.pairs_selected()),
+                    "seed {seed}, F = {}",
+                    p.flow
+                );
+            }
+            let chosen = plain.selection.flow.max(1);
+            let last = extended.beyond.last().or(extended.curve.last()).unwrap();
+            let limit = (4 * chosen).min(2 * problem.pairs.len() as u64);
+            assert!(
+                last.flow >= limit.min(fresh.max_flow())
+                    || last.pairs_selected == problem.pairs.len(),
+                "seed {seed}: the curve stops early at F = {}",
+                last.flow
+            );
+        }
+    }
 }

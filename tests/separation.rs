@@ -37,6 +37,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         }),
         model: all_priors(),
         unweighted_priors: true,
+        curve_factor: 0,
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();
     eprintln!("plan: {:?}", p.timings);

@@ -12,6 +12,7 @@ pub mod export;
 #[cfg(feature = "eval")]
 pub mod generate;
 pub mod inspect;
+pub mod progress;
 pub mod prune;
 pub mod restore;
 pub mod solve;

@@ -2,6 +2,7 @@
 //! two_view_geometries, in place (reversible by `restore`) or in a copy.
 
 use super::args::{fraction, weights, DatabaseArg, FlowArgs, Weights};
+use crate::cli::progress::Progress;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -10,7 +11,6 @@ use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::rewrite;
 use vgsel_colmap::outputs::report::{Outputs, Report};
 use vgsel_colmap::outputs::{export, plots, scores};
-use vgsel_colmap::progress::Progress;
 use vgsel_colmap::selection::overrides::{NameList, Overrides};
 use vgsel_colmap::selection::parameters::Parameters;
 use vgsel_colmap::selection::pipeline as prune;
@@ -135,7 +135,10 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         forbid_pairs: path_text(&args.forbid_pairs),
         forbid_images: path_text(&args.forbid_images),
     };
-    let options = parameters.options(args.scores.is_some());
+    let mut options = parameters.options(args.scores.is_some());
+    if args.plots.is_some() {
+        options.curve_factor = plots::CURVE_FACTOR;
+    }
     let stage = |s: &str| progress.stage(s);
     let overrides = args.overrides()?;
     let mut plan = prune::plan_with(&db, &options, &overrides, &stage)?;
@@ -158,7 +161,8 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         scores::write(&plan, path)?;
     }
     if let Some(dir) = &args.plots {
-        let files = plots::write(&plan, dir, progress)?;
+        progress.stage("drawing plots");
+        let files = plots::write(&plan, dir)?;
         outputs.plots = files.iter().map(|f| f.display().to_string()).collect();
     }
     let written_to = if args.dry_run {

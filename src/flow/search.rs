@@ -83,6 +83,8 @@ pub struct SearchResult {
     pub capped: bool,
     /// Images and pairs selected for F = 1, 2, ... up to the chosen F.
     pub curve: Vec<CurvePoint>,
+    /// The curve past the last F in `curve`, when asked for ([`search_with_curve`]).
+    pub beyond: Vec<CurvePoint>,
 }
 
 /// Target counts (images, pairs) of `criteria` for `problem`.
@@ -126,18 +128,41 @@ fn point(solver: &ParametricSolver) -> CurvePoint {
 /// Runs `rule` on `problem`. The curve starts at F = 0 and ends at the chosen F (for a capped
 /// criteria search: at the last F examined).
 pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
+    search_with_curve(problem, rule, 0)
+}
+
+/// [`search`], then the same solver goes on past the chosen F to record `beyond`: up to `factor`
+/// times that F (at most 2|E|), stopping once every pair is selected (`--plots` draws what more
+/// flow would buy). The selection stays the chosen one. `factor` 0 records nothing more.
+pub fn search_with_curve(problem: &SelectionProblem, rule: &FlowRule, factor: u64) -> SearchResult {
     let mut solver = ParametricSolver::new(problem);
-    let mut curve = vec![point(&solver)];
+    let mut result = run(&mut solver, problem, rule);
+    if factor > 0 {
+        let chosen = result.selection.flow.max(1);
+        let limit = (factor * chosen).min(2 * problem.pairs.len() as u64);
+        let all_pairs = |solver: &ParametricSolver| {
+            solver.pairs_selected() == problem.pairs.len() && solver.flow() >= chosen
+        };
+        while !all_pairs(&solver) && solver.flow() < limit && solver.augment().is_some() {
+            result.beyond.push(point(&solver));
+        }
+    }
+    result
+}
+
+fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
+    let mut curve = vec![point(solver)];
     match *rule {
         FlowRule::Fixed(f) => {
             while solver.flow() < f && solver.augment().is_some() {
-                curve.push(point(&solver));
+                curve.push(point(solver));
             }
             SearchResult {
                 selection: solver.selection(),
                 criteria: Vec::new(),
                 capped: false,
                 curve,
+                beyond: Vec::new(),
             }
         }
         FlowRule::Criteria(criteria) => {
@@ -177,7 +202,7 @@ pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
                     if solver.flow() >= last_useful || solver.augment().is_none() {
                         break;
                     }
-                    curve.push(point(&solver));
+                    curve.push(point(solver));
                 }
             }
             let status =
@@ -206,6 +231,7 @@ pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
                         criteria,
                         capped: false,
                         curve,
+                        beyond: Vec::new(),
                     }
                 }
                 None => {
@@ -227,6 +253,7 @@ pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
                         criteria,
                         capped: true,
                         curve,
+                        beyond: Vec::new(),
                     }
                 }
             }

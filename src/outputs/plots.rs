@@ -1,7 +1,5 @@
 //! `--plots DIR`: the selection curve (the paper's Figure 3) and COLMAP-style match matrix, as SVG.
 
-use crate::flow::solver::ParametricSolver;
-use crate::progress::Progress;
 use crate::selection::pipeline::Plan;
 use anyhow::{anyhow, Context, Result};
 use plotters::prelude::*;
@@ -15,39 +13,44 @@ const MAX_CELLS: usize = 600;
 pub type Point = (u64, [f64; 2]);
 
 /// Writes `selection_curve.svg` and `match_matrix.svg` into `dir` (created if missing) and
-/// returns their paths.
-pub fn write(plan: &Plan, dir: &Path, progress: &Progress) -> Result<Vec<PathBuf>> {
+/// returns their paths. Draws what the plan recorded; the curve past the chosen F is there when
+/// the pipeline ran with [`CURVE_FACTOR`].
+pub fn write(plan: &Plan, dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let curve_path = dir.join("selection_curve.svg");
-    let curve = curve_points(plan, progress);
-    progress.stage("drawing plots");
-    selection_curve(&curve, plan, &curve_path)?;
+    selection_curve(&curve_points(plan), plan, &curve_path)?;
     let matrix_path = dir.join("match_matrix.svg");
     match_matrix(plan, &matrix_path)?;
     Ok(vec![curve_path, matrix_path])
 }
 
-/// The curve for F = 1, 2, ... up to four times the chosen F — past the choice, to show what more flow would buy — and
-/// no further than the flow selecting every pair.
-pub fn curve_points(plan: &Plan, progress: &Progress) -> Vec<Point> {
+/// How far past the chosen F the selection curve goes: to show what more flow would buy.
+pub const CURVE_FACTOR: u64 = 4;
+
+/// The curve for F = 1, 2, ... up to [`CURVE_FACTOR`] times the chosen F, no further than the
+/// flow selecting every pair, as fractions of the network's images and pairs.
+pub fn curve_points(plan: &Plan) -> Vec<Point> {
     let problem = &plan.network.problem;
     let images = problem.image_costs.len().max(1) as f64;
     let pairs = problem.pairs.len().max(1) as f64;
     let chosen = plan.search.selection.flow.max(1);
-    let limit = (4 * chosen).min(2 * problem.pairs.len() as u64);
-    let bar = progress.bar("selection curve up to 4 F", limit);
-    let mut solver = ParametricSolver::new(problem);
+    let limit = (CURVE_FACTOR * chosen).min(2 * problem.pairs.len() as u64);
     let mut points = Vec::new();
-    while solver.flow() < limit && solver.augment().is_some() {
-        bar.set_position(solver.flow());
+    for p in plan.search.curve.iter().chain(&plan.search.beyond) {
+        if p.flow == 0 {
+            continue;
+        }
+        if p.flow > limit {
+            break;
+        }
         points.push((
-            solver.flow(),
+            p.flow,
             [
-                solver.images_selected() as f64 / images,
-                solver.pairs_selected() as f64 / pairs,
+                p.images_selected as f64 / images,
+                p.pairs_selected as f64 / pairs,
             ],
         ));
-        if solver.pairs_selected() == problem.pairs.len() && solver.flow() >= chosen {
+        if p.pairs_selected == problem.pairs.len() && p.flow >= chosen {
             break;
         }
     }

@@ -65,6 +65,7 @@ impl Parameters {
             rule: self.rule(),
             model: self.cost_model.clone(),
             unweighted_priors,
+            curve_factor: 0,
         }
     }
 }

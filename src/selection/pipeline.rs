@@ -27,6 +27,8 @@ pub struct Options {
     /// `--scores`. Otherwise they are skipped, which matters at scale (multiple motions run a
     /// RANSAC per pair).
     pub unweighted_priors: bool,
+    /// Continue the selection curve to this many times the chosen F (0: stop there), for plots.
+    pub curve_factor: u64,
 }
 
 /// Seconds spent in each stage.
@@ -128,7 +130,8 @@ pub fn plan_with(
         }
     }
     let network = problem(&graph, &costs).restrict(&resolved.forbidden_vertices, &resolved.edges);
-    let mut search = search::search(&network.problem, &options.rule);
+    let mut search =
+        search::search_with_curve(&network.problem, &options.rule, options.curve_factor);
     search.selection = network.expand(&search.selection);
     timings.solve = t.elapsed().as_secs_f64();
 
@@ -314,6 +317,7 @@ mod tests {
             },
             model: CostModel::disambiguation(),
             unweighted_priors: false,
+            curve_factor: 0,
         };
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already, and
         // half of 0.4 pairs per image x 5 images is one pair.

@@ -1,5 +1,5 @@
-//! What the user sees while a command runs: a spinner per stage (or a bar where the length is
-//! known) when stderr is a terminal, plain timestamped lines with `-v`, nothing otherwise or with
+//! What the user sees while a command runs: a spinner per stage with its elapsed time when
+//! stderr is a terminal, plain timestamped lines with `-v`, nothing otherwise or with
 //! `-q` — logs and pipes stay clean, and errors are always the last line.
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -14,6 +14,7 @@ enum Mode {
     Lines,
 }
 
+/// Reports the stages of a command on stderr, in the mode chosen by `-q`, `-v` and the terminal.
 pub struct Progress {
     mode: Mode,
     started: Instant,
@@ -57,27 +58,6 @@ impl Progress {
         }
     }
 
-    /// A stage of `len` steps: returns the bar to advance (hidden unless bars are shown).
-    pub fn bar(&self, name: &str, len: u64) -> ProgressBar {
-        self.finish();
-        match self.mode {
-            Mode::Bars => {
-                let bar = ProgressBar::new(len).with_message(name.to_string());
-                bar.set_style(
-                    ProgressStyle::with_template("{msg} {wide_bar} {pos}/{len} [{elapsed}]")
-                        .expect("valid template"),
-                );
-                *self.current.borrow_mut() = Some(bar.clone());
-                bar
-            }
-            Mode::Lines => {
-                self.line(&format!("{name} ({len} steps)"));
-                ProgressBar::hidden()
-            }
-            Mode::Silent => ProgressBar::hidden(),
-        }
-    }
-
     /// A detail line, shown with `-v` only.
     pub fn detail(&self, text: &str) {
         if self.mode == Mode::Lines {
@@ -85,7 +65,7 @@ impl Progress {
         }
     }
 
-    /// Clears the current spinner or bar (before a summary or an error is printed).
+    /// Clears the current spinner (before a summary or an error is printed).
     pub fn finish(&self) {
         if let Some(bar) = self.current.borrow_mut().take() {
             bar.finish_and_clear();
