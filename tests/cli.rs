@@ -4,7 +4,7 @@
 use crate::support::{dump, ok, scene, schema, table_names, user_version, vgsel};
 use rusqlite::types::Value;
 use std::path::Path;
-use vgsel_colmap::colmap::database::image_ids;
+use vgsel_colmap::colmap::ids::image_ids;
 
 /// Fails with exit status 1 and one error line on stderr, the last (progress lines may precede
 /// it); returns that line.

@@ -5,6 +5,7 @@ use crate::support::*;
 use rusqlite::{params, Connection};
 use std::time::Duration;
 use vgsel_colmap::colmap::database::*;
+use vgsel_colmap::colmap::ids::*;
 
 fn err<T>(r: anyhow::Result<T>) -> String {
     match r {

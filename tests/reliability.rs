@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 use tempfile::TempDir;
-use vgsel_colmap::colmap::database::image_ids;
+use vgsel_colmap::colmap::ids::image_ids;
 use vgsel_colmap::eval::synth::{generate, SceneSpec};
 
 /// Every file under `dir` (names relative to it) with its bytes.

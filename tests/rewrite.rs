@@ -5,7 +5,8 @@ use rusqlite::types::Value;
 use rusqlite::Connection;
 use std::path::Path;
 use std::time::Duration;
-use vgsel_colmap::colmap::database::{pair_id, Database};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::ids::pair_id;
 use vgsel_colmap::colmap::rewrite::{apply, copy_database, last_run, restore, RunRecord};
 
 fn run(n: usize) -> RunRecord<serde_json::Value> {
@@ -64,7 +65,7 @@ fn apply_invalidates_exactly_the_given_pairs() {
         let ncols = after[0].len();
         assert_eq!(ncols, if layout == Layout::Latest { 12 } else { 10 });
         for (before, now) in tvg.iter().zip(&after) {
-            let pair = vgsel_colmap::colmap::database::image_ids(match now[0].1 {
+            let pair = vgsel_colmap::colmap::ids::image_ids(match now[0].1 {
                 Value::Integer(i) => i as u64,
                 _ => panic!(),
             });

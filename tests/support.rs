@@ -6,7 +6,7 @@ use rusqlite::types::Value;
 use rusqlite::{params, Connection};
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
-use vgsel_colmap::colmap::database::pair_id;
+use vgsel_colmap::colmap::ids::pair_id;
 
 pub const COLMAP_38_SQL: &str = include_str!("../sql/colmap-3.8.sql");
 pub const COLMAP_LATEST_SQL: &str = include_str!("../sql/colmap-latest.sql");

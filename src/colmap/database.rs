@@ -17,22 +17,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-/// COLMAP's pair_id base: pair_id = 2147483647 * id1 + id2 with id1 < id2.
-pub const MAX_NUM_IMAGES: u64 = 2_147_483_647;
-
-/// pair_id of two image ids, in either order.
-pub fn pair_id(a: u32, b: u32) -> u64 {
-    let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
-    MAX_NUM_IMAGES * lo as u64 + hi as u64
-}
-
-/// The two image ids (smaller first) of a pair_id.
-pub fn image_ids(pair_id: u64) -> (u32, u32) {
-    (
-        (pair_id / MAX_NUM_IMAGES) as u32,
-        (pair_id % MAX_NUM_IMAGES) as u32,
-    )
-}
+use super::ids::{camera_model_name, camera_model_num_params, image_ids, pair_id};
 
 /// How long a statement waits for another process's lock before failing (COLMAP GUI, a running
 /// matcher); long enough for a short write, short enough not to look hung.
@@ -121,44 +106,6 @@ pub struct TwoViewGeometry {
     pub h: Option<[f64; 9]>,
     pub qvec: Option<[f64; 4]>,
     pub tvec: Option<[f64; 3]>,
-}
-
-/// Number of f64 parameters of COLMAP camera model `model_id`; None for models we do not know.
-pub fn camera_model_num_params(model_id: i32) -> Option<usize> {
-    Some(match model_id {
-        0 => 3,   // SIMPLE_PINHOLE
-        1 => 4,   // PINHOLE
-        2 => 4,   // SIMPLE_RADIAL
-        3 => 5,   // RADIAL
-        4 => 8,   // OPENCV
-        5 => 8,   // OPENCV_FISHEYE
-        6 => 12,  // FULL_OPENCV
-        7 => 5,   // FOV
-        8 => 4,   // SIMPLE_RADIAL_FISHEYE
-        9 => 5,   // RADIAL_FISHEYE
-        10 => 12, // THIN_PRISM_FISHEYE
-        _ => return None,
-    })
-}
-
-/// COLMAP's name of camera model `model_id`, for messages.
-pub fn camera_model_name(model_id: i32) -> Option<&'static str> {
-    const NAMES: [&str; 11] = [
-        "SIMPLE_PINHOLE",
-        "PINHOLE",
-        "SIMPLE_RADIAL",
-        "RADIAL",
-        "OPENCV",
-        "OPENCV_FISHEYE",
-        "FULL_OPENCV",
-        "FOV",
-        "SIMPLE_RADIAL_FISHEYE",
-        "RADIAL_FISHEYE",
-        "THIN_PRISM_FISHEYE",
-    ];
-    usize::try_from(model_id)
-        .ok()
-        .and_then(|i| NAMES.get(i).copied())
 }
 
 /// Turns an SQLite error into a one-line message naming the file; lock and "not a database"

@@ -2,5 +2,6 @@
 //! sparse models. The rest of the crate sees COLMAP only through these types.
 
 pub mod database;
+pub mod ids;
 pub mod model;
 pub mod rewrite;

@@ -7,9 +7,8 @@
 //! `vgsel_backup` (sql/vgsel.sql), whose untyped columns keep each value's storage class, so a
 //! restore is byte for byte.
 
-use crate::colmap::database::{
-    image_ids, sql_error, table_exists, Database, SqlResult, TWO_VIEW_COLUMNS,
-};
+use crate::colmap::database::{sql_error, table_exists, Database, SqlResult, TWO_VIEW_COLUMNS};
+use crate::colmap::ids::{image_ids, TwoViewConfig};
 use anyhow::{anyhow, bail, Result};
 use rusqlite::{Connection, OpenFlags, Transaction, TransactionBehavior};
 use serde::de::DeserializeOwned;
@@ -168,7 +167,7 @@ fn apply_in<P>(
         .map(|c| match *c {
             "rows" => "rows = 0".to_string(),
             "cols" => "cols = 2".to_string(),
-            "config" => "config = 1".to_string(),
+            "config" => format!("config = {}", TwoViewConfig::Degenerate.code()),
             other => format!("{other} = NULL"),
         })
         .collect();

@@ -6,7 +6,8 @@
 //! Why: the mapper's model only shows the end result; counting the false pairs a prune removed
 //! and the true pairs it kept says whether the selection itself did the right thing.
 
-use crate::colmap::database::{image_ids, Database};
+use crate::colmap::database::Database;
+use crate::colmap::ids::image_ids;
 use crate::colmap::model;
 use anyhow::{bail, ensure, Context, Result};
 use nalgebra::{Matrix3, Vector3};
@@ -167,7 +168,7 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
     let mut labels = HashMap::new();
     for pair in db.verified_pairs()? {
         let ids = [pair.image_id1, pair.image_id2];
-        let pid = crate::colmap::database::pair_id(ids[0], ids[1]);
+        let pid = crate::colmap::ids::pair_id(ids[0], ids[1]);
         let poses: Option<Vec<&model::ModelImage>> =
             ids.iter().map(|id| truth.get(&names[id])).collect();
         let Some(poses) = poses else {

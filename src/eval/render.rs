@@ -11,7 +11,8 @@
 //! (COLMAP's pixel convention: the centre of pixel (i, j) is at (i + 0.5, j + 0.5)); the ground
 //! truth is written as a COLMAP text model. Everything is deterministic from the seed.
 
-use crate::eval::synth::{look_at, write_gt_model, GroundTruth, GtCamera, GtImage, SIMPLE_RADIAL};
+use crate::colmap::ids::SIMPLE_RADIAL;
+use crate::eval::synth::{look_at, write_gt_model, GroundTruth, GtCamera, GtImage};
 use anyhow::{ensure, Context, Result};
 use nalgebra::{Rotation3, Vector3};
 use rand::{Rng, SeedableRng};

@@ -5,7 +5,8 @@
 //! is mapped to a calibration matrix K and OpenCV distortion coefficients (k1, k2, p1, p2[, k3..k6]),
 //! which have the same meaning as COLMAP's for the supported models.
 
-use crate::colmap::database::{camera_model_name, Camera};
+use crate::colmap::database::Camera;
+use crate::colmap::ids::camera_model_name;
 use anyhow::{bail, Result};
 use nalgebra::Matrix3;
 use opencv::core::{Mat, Point2d, Vector};

@@ -7,17 +7,11 @@
 //! not satisfy (missing, degenerate, or written by another tool for another pose) is replaced by
 //! `findEssentialMat` on the inliers, so a pose always explains the pair's own inliers.
 
+use crate::colmap::ids::TwoViewConfig;
 use anyhow::Result;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use opencv::core::{Mat, Point2d, Vector};
 use opencv::prelude::*;
-
-/// COLMAP TwoViewGeometry configs.
-pub const CONFIG_CALIBRATED: i32 = 2;
-pub const CONFIG_UNCALIBRATED: i32 = 3;
-pub const CONFIG_PLANAR: i32 = 4;
-pub const CONFIG_PANORAMIC: i32 = 5;
-pub const CONFIG_PLANAR_OR_PANORAMIC: i32 = 6;
 
 /// Where a pose came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -295,9 +289,10 @@ const MIN_EXPLAINED: f64 = 0.5;
 /// The relative pose of a verified pair; see the module docs for the order of attempts.
 pub fn pair_pose(g: &StoredGeometry) -> Result<Option<RelativePose>> {
     let n = g.x1.len();
-    let essential = match g.config {
-        CONFIG_CALIBRATED => g.e.map(|e| (e, PoseSource::Essential)),
-        CONFIG_UNCALIBRATED => {
+    let config = TwoViewConfig::from_code(g.config);
+    let essential = match config {
+        Some(TwoViewConfig::Calibrated) => g.e.map(|e| (e, PoseSource::Essential)),
+        Some(TwoViewConfig::Uncalibrated) => {
             g.f.map(|f| (g.k2.transpose() * f * g.k1, PoseSource::Fundamental))
         }
         _ => None,
@@ -313,8 +308,8 @@ pub fn pair_pose(g: &StoredGeometry) -> Result<Option<RelativePose>> {
         }
     }
     let planar = matches!(
-        g.config,
-        CONFIG_PLANAR | CONFIG_PANORAMIC | CONFIG_PLANAR_OR_PANORAMIC
+        config,
+        Some(TwoViewConfig::Planar | TwoViewConfig::Panoramic | TwoViewConfig::PlanarOrPanoramic)
     );
     if let (true, Some(h), Some(k2_inv)) = (planar, g.h, g.k2.try_inverse()) {
         let hn = k2_inv * h * g.k1;
@@ -421,25 +416,29 @@ pub(crate) mod tests {
             x2: &x2,
             threshold: 1e-3,
         };
-        let p = pair_pose(&base(CONFIG_CALIBRATED, Some(e), None))
+        let p = pair_pose(&base(TwoViewConfig::Calibrated.code(), Some(e), None))
             .unwrap()
             .unwrap();
         assert_eq!(p.source, PoseSource::Essential);
         close(&p, &r, &t, 1e-6);
-        let p = pair_pose(&base(CONFIG_UNCALIBRATED, None, Some(f * 3.0)))
-            .unwrap()
-            .unwrap();
+        let p = pair_pose(&base(
+            TwoViewConfig::Uncalibrated.code(),
+            None,
+            Some(f * 3.0),
+        ))
+        .unwrap()
+        .unwrap();
         assert_eq!(p.source, PoseSource::Fundamental);
         close(&p, &r, &t, 1e-6);
         // A stored E of another pose is not trusted: the pose is estimated from the inliers.
         let wrong = skew(&Vector3::new(0.0, 1.0, 0.0))
             * Rotation3::from_euler_angles(0.4, 0.0, 0.0).matrix();
-        let p = pair_pose(&base(CONFIG_CALIBRATED, Some(wrong), None))
+        let p = pair_pose(&base(TwoViewConfig::Calibrated.code(), Some(wrong), None))
             .unwrap()
             .unwrap();
         assert_eq!(p.source, PoseSource::Estimated);
         close(&p, &r, &t, 0.5);
-        let p = pair_pose(&base(CONFIG_CALIBRATED, None, None))
+        let p = pair_pose(&base(TwoViewConfig::Calibrated.code(), None, None))
             .unwrap()
             .unwrap();
         assert_eq!(p.source, PoseSource::Estimated);
@@ -461,7 +460,7 @@ pub(crate) mod tests {
         let h = r.matrix() + t * Vector3::new(0.0, 0.0, 1.0).transpose() / 5.0;
         let k = Matrix3::identity();
         let g = StoredGeometry {
-            config: CONFIG_PLANAR,
+            config: TwoViewConfig::Planar.code(),
             e: None,
             f: None,
             h: Some(h),

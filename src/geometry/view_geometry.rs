@@ -1,4 +1,4 @@
-//! The geometric scene of the pose-based priors: each vertex's camera model and undistorted
+//! The geometric inputs of the pose-based priors: each vertex's camera model and undistorted
 //! normalised keypoints, and each edge's relative pose ([`crate::geometry::pose::pair_pose`]).
 //! Computed once per prune, in parallel over images and pairs.
 

@@ -7,7 +7,8 @@
 //! selection, and reads kept/removed from the database itself: an edge is removed when its
 //! original row is in `vgsel_backup`.
 
-use crate::colmap::database::{pair_id, Database, SqlResult};
+use crate::colmap::database::{Database, SqlResult};
+use crate::colmap::ids::pair_id;
 use crate::colmap::rewrite;
 use crate::flow::search::FlowRule;
 use crate::selection::overrides::Overrides;

@@ -122,6 +122,7 @@ pub fn compute(scene: &Scene) -> Vec<PriorValues> {
 mod tests {
     use super::*;
     use crate::colmap::database::{Image, VerifiedPair};
+    use crate::scene::testing::{images, pair};
     use crate::scene::view_graph::ViewGraph;
 
     /// Images 1, 2 see copy A with surroundings seen by image 3; image 4 sees copy B with
@@ -129,19 +130,8 @@ mod tests {
     /// on keypoints 0..20 (pair (1, 4) only on 0..10, whose hull holds 10..20), the
     /// surroundings are keypoints 20..40.
     fn two_copies() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
-        let images = (1..=5)
-            .map(|id| Image {
-                image_id: id,
-                name: format!("{id}"),
-                camera_id: 1,
-            })
-            .collect::<Vec<_>>();
-        let pair = |a, b, range: std::ops::Range<u32>| VerifiedPair {
-            image_id1: a,
-            image_id2: b,
-            config: 2,
-            inliers: range.map(|k| [k, k]).collect(),
-        };
+        let images = images(5);
+        let pair = |a, b, range: std::ops::Range<u32>| pair(a, b, range.map(|k| [k, k]).collect());
         let pairs = vec![
             pair(1, 2, 0..20),
             pair(1, 3, 20..40),

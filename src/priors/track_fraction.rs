@@ -32,33 +32,14 @@ pub fn compute(scene: &Scene) -> PriorValues {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::colmap::database::{Image, VerifiedPair};
+    use crate::scene::testing::{images, pair};
     use crate::scene::view_graph::ViewGraph;
 
     #[test]
     fn counts_each_keypoint_once_across_pairs() {
-        let images: Vec<Image> = (1..=3)
-            .map(|id| Image {
-                image_id: id,
-                name: id.to_string(),
-                camera_id: 1,
-            })
-            .collect();
+        let images = images(3);
         // Pair ids are stored with the larger image first here to exercise orientation.
-        let pairs = vec![
-            VerifiedPair {
-                image_id1: 1,
-                image_id2: 2,
-                config: 2,
-                inliers: vec![[0, 1], [1, 2]],
-            },
-            VerifiedPair {
-                image_id1: 1,
-                image_id2: 3,
-                config: 2,
-                inliers: vec![[0, 3]],
-            },
-        ];
+        let pairs = vec![pair(1, 2, vec![[0, 1], [1, 2]]), pair(1, 3, vec![[0, 3]])];
         let graph = ViewGraph::build(&images, &pairs, 1);
         let scene = Scene::new(
             &graph,

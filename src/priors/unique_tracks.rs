@@ -76,17 +76,8 @@ pub fn compute(scene: &Scene) -> PriorValues {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::colmap::database::{Image, VerifiedPair};
+    use crate::scene::testing::{images, pair};
     use crate::scene::view_graph::ViewGraph;
-
-    fn pair(a: u32, b: u32, inliers: Vec<[u32; 2]>) -> VerifiedPair {
-        VerifiedPair {
-            image_id1: a,
-            image_id2: b,
-            config: 2,
-            inliers,
-        }
-    }
 
     #[test]
     fn inliers_on_a_track_seen_everywhere_are_confusing() {
@@ -94,13 +85,7 @@ mod tests {
         // keypoint 0 of every image is matched to keypoint 0 of every other image: one track
         // seen by all 12 images, 6 times the median (2).
         let n = 12;
-        let images: Vec<Image> = (1..=n)
-            .map(|id| Image {
-                image_id: id,
-                name: id.to_string(),
-                camera_id: 1,
-            })
-            .collect();
+        let images = images(n);
         let mut pairs = Vec::new();
         for a in 1..=n {
             for b in a + 1..=n {

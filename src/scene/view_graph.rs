@@ -183,21 +183,10 @@ fn count_common(a: &[u32], b: &[u32]) -> usize {
 mod tests {
     use super::*;
 
-    fn pair(a: u32, b: u32, n: usize) -> VerifiedPair {
-        VerifiedPair {
-            image_id1: a,
-            image_id2: b,
-            config: 2,
-            inliers: vec![[0, 0]; n],
-        }
-    }
+    use crate::scene::testing::image;
 
-    fn image(id: u32) -> Image {
-        Image {
-            image_id: id,
-            name: format!("{id}.png"),
-            camera_id: 1,
-        }
+    fn pair(a: u32, b: u32, n: usize) -> VerifiedPair {
+        crate::scene::testing::pair(a, b, vec![[0, 0]; n])
     }
 
     /// Triangle 1-2-3, tail 3-7, weak pair 7-9 below the threshold, image 5 without pairs.

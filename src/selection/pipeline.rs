@@ -1,7 +1,8 @@
 //! The prune pipeline up to the selection: read the database, build the view graph, compute the
 //! priors and costs, run the flow search. It writes nothing; [`crate::colmap::rewrite`] applies the plan.
 
-use crate::colmap::database::{pair_id, Camera, Database, Image, TwoViewGeometry, VerifiedPair};
+use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, VerifiedPair};
+use crate::colmap::ids::pair_id;
 use crate::costs::{self, CostModel, Costs};
 use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
 use crate::flow::search::{self, FlowRule, SearchResult};
@@ -285,25 +286,13 @@ pub fn fitness_floor(options: &Options, graph: &ViewGraph, pair_costs: &[f64]) -
 mod tests {
     use super::*;
     use crate::flow::search::Criteria;
+    use crate::scene::testing::{images, pair};
 
     #[test]
     fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {
         // A path 1-2-3-4-5: pair fitnesses 0.9, 0.8, 0.2, 0.1.
-        let images: Vec<Image> = (1..=5)
-            .map(|id| Image {
-                image_id: id,
-                name: id.to_string(),
-                camera_id: 1,
-            })
-            .collect();
-        let pairs: Vec<VerifiedPair> = (1..5)
-            .map(|a| VerifiedPair {
-                image_id1: a,
-                image_id2: a + 1,
-                config: 2,
-                inliers: vec![[0, 0]; 20],
-            })
-            .collect();
+        let images = images(5);
+        let pairs: Vec<VerifiedPair> = (1..5).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
         let graph = ViewGraph::build(&images, &pairs, 15);
         let costs = [-0.9, -0.8, -0.2, -0.1];
         let options = |fraction: f64, per_image: f64, rule: Option<u64>| Options {

@@ -31,6 +31,7 @@
 
 pub mod duplicate;
 
+use crate::colmap::ids::{self, TwoViewConfig, SIMPLE_RADIAL};
 use crate::colmap::model::ModelImage;
 use anyhow::{bail, ensure, Context, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
@@ -42,15 +43,6 @@ use rusqlite::{params, Connection};
 use std::collections::HashSet;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// COLMAP's pair_id base (kept local so this module needs nothing from `database`).
-const MAX_NUM_IMAGES: u64 = 2_147_483_647;
-/// COLMAP camera model id of SIMPLE_RADIAL (params f, cx, cy, k).
-pub const SIMPLE_RADIAL: i32 = 2;
-/// TwoViewGeometry::CALIBRATED.
-pub const CONFIG_CALIBRATED: i32 = 2;
-/// TwoViewGeometry::UNCALIBRATED.
-pub const CONFIG_UNCALIBRATED: i32 = 3;
 
 /// What to generate. Every field has a default (see [`Default`]) sized for CI.
 #[derive(Clone, Debug)]
@@ -665,7 +657,7 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
             for b in a + 1..n {
                 let id1 = images[a as usize].image_id as u64;
                 let id2 = images[b as usize].image_id as u64;
-                let pair_id = MAX_NUM_IMAGES * id1 + id2;
+                let pair_id = ids::pair_id(id1 as u32, id2 as u32);
                 let corr = &buckets[b as usize];
                 if corr.is_empty() {
                     if spec.all_pairs {
@@ -752,8 +744,8 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
                     };
                     ins_match.execute(params![pair_id, matches.len(), pairs_blob(&matches)])?;
                     let (config, e) = match spec.stored_focal {
-                        None => (CONFIG_CALIBRATED, Some(matrix_blob(&e))),
-                        Some(_) => (CONFIG_UNCALIBRATED, None),
+                        None => (TwoViewConfig::Calibrated.code(), Some(matrix_blob(&e))),
+                        Some(_) => (TwoViewConfig::Uncalibrated.code(), None),
                     };
                     ins_tvg.execute(params![
                         pair_id,
