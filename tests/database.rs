@@ -4,6 +4,7 @@ use crate::support::Layout; // not database::Layout
 use crate::support::*;
 use rusqlite::{params, Connection};
 use std::time::Duration;
+use vgsel_colmap::colmap::blob::*;
 use vgsel_colmap::colmap::database::*;
 use vgsel_colmap::colmap::ids::*;
 

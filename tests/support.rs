@@ -34,20 +34,10 @@ impl Layout {
     }
 }
 
-pub fn f32_blob(values: &[f32]) -> Vec<u8> {
-    values.iter().flat_map(|v| v.to_le_bytes()).collect()
-}
-pub fn f64_blob(values: &[f64]) -> Vec<u8> {
-    values.iter().flat_map(|v| v.to_le_bytes()).collect()
-}
-pub fn pairs_blob(pairs: &[[u32; 2]]) -> Vec<u8> {
-    pairs
-        .iter()
-        .flat_map(|p| p.iter().flat_map(|v| v.to_le_bytes()))
-        .collect()
-}
+pub use vgsel_colmap::colmap::blob::{
+    encode_f32 as f32_blob, encode_f64 as f64_blob, encode_pairs as pairs_blob,
+};
 
-/// An empty database of `layout` at `dir/name`.
 pub fn empty_db(dir: &Path, name: &str, layout: Layout) -> PathBuf {
     let path = dir.join(name);
     let conn = Connection::open(&path).unwrap();

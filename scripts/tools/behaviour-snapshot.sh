@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Everything a user can observe of a vgsel-colmap binary on one database, written to a folder so
 # that two binaries (before and after a refactoring) compare with `diff -r`: every --help text,
-# completions, the man page, and for both presets the report JSON (timings and clocks removed),
+# completions, the man page, a generated database and graph, and for both presets the report JSON (timings and clocks removed),
 # the --scores CSV, the pair list, the plots, the pruned database's SQL dump (run times removed),
 # inspect, both exports and the restored dump.
 # usage: scripts/tools/behaviour-snapshot.sh BINARY DATABASE OUTDIR
@@ -36,6 +36,11 @@ for sub in images database graph; do
   "$bin" generate "$sub" --help >"help-generate-$sub.txt"
 done
 "$bin" completions bash >completions.bash
+# The evaluation tooling's outputs: a synthetic database with its ground truth, a paper graph.
+"$bin" -q generate database --output gen.db --ground_truth gen-gt >/dev/null
+dump gen.db >generated.sql
+rm -f gen.db*
+"$bin" -q generate graph --images 50 --pairs 400 --output generated.graph >/dev/null
 "$bin" man >man.1
 
 for preset in general disambiguation; do

@@ -31,6 +31,7 @@
 
 pub mod duplicate;
 
+use crate::colmap::blob::{encode_f64, encode_mat3, encode_pairs};
 use crate::colmap::ids::{self, TwoViewConfig, SIMPLE_RADIAL};
 use crate::colmap::model::ModelImage;
 use anyhow::{bail, ensure, Context, Result};
@@ -486,27 +487,6 @@ pub fn pair_geometry(
     (e, f, h)
 }
 
-fn matrix_blob(m: &Matrix3<f64>) -> Vec<u8> {
-    let mut out = Vec::with_capacity(72);
-    for r in 0..3 {
-        for c in 0..3 {
-            out.extend_from_slice(&m[(r, c)].to_le_bytes());
-        }
-    }
-    out
-}
-
-fn f64_blob(values: &[f64]) -> Vec<u8> {
-    values.iter().flat_map(|v| v.to_le_bytes()).collect()
-}
-
-fn pairs_blob(pairs: &[[u32; 2]]) -> Vec<u8> {
-    pairs
-        .iter()
-        .flat_map(|p| p.iter().flat_map(|v| v.to_le_bytes()))
-        .collect()
-}
-
 /// Writes a synthetic COLMAP 3.8 database for `spec` at `database_path` (which must not exist)
 /// and returns its ground truth. Everything is written in one transaction.
 pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
@@ -586,7 +566,7 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
                 camera.model_id,
                 camera.width,
                 camera.height,
-                f64_blob(&stored_params),
+                encode_f64(&stored_params),
                 spec.stored_focal.is_none()
             ],
         )?;
@@ -629,7 +609,7 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
                             pair_id: u64,
                             matches: &[[u32; 2]]|
          -> Result<()> {
-            let data = (!matches.is_empty()).then(|| pairs_blob(matches));
+            let data = (!matches.is_empty()).then(|| encode_pairs(matches));
             ins_match.execute(params![pair_id, matches.len(), data])?;
             let null = None::<Vec<u8>>;
             ins_tvg.execute(params![pair_id, 0, null, 0, null, null, null, null, null])?;
@@ -742,21 +722,21 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
                     } else {
                         (vec![0.0; 4], vec![0.0; 3])
                     };
-                    ins_match.execute(params![pair_id, matches.len(), pairs_blob(&matches)])?;
+                    ins_match.execute(params![pair_id, matches.len(), encode_pairs(&matches)])?;
                     let (config, e) = match spec.stored_focal {
-                        None => (TwoViewConfig::Calibrated.code(), Some(matrix_blob(&e))),
+                        None => (TwoViewConfig::Calibrated.code(), Some(encode_mat3(&e))),
                         Some(_) => (TwoViewConfig::Uncalibrated.code(), None),
                     };
                     ins_tvg.execute(params![
                         pair_id,
                         inliers.len(),
-                        pairs_blob(&inliers),
+                        encode_pairs(&inliers),
                         config,
-                        matrix_blob(&f),
+                        encode_mat3(&f),
                         e,
-                        matrix_blob(&h),
-                        f64_blob(&qvec),
-                        f64_blob(&tvec)
+                        encode_mat3(&h),
+                        encode_f64(&qvec),
+                        encode_f64(&tvec)
                     ])?;
                     gt.num_inliers = inliers.len();
                     gt.true_pair = 2 * num_true_inliers >= inliers.len();
