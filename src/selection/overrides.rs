@@ -178,7 +178,7 @@ impl Overrides {
                 };
                 if edges[k] == ArcRule::Removed {
                     bail!(
-                        "{where_}: `{}` `{}` is kept but also forbidden (--forbid_pairs or --forbid_images)",
+                        "{where_}: `{}` `{}` is kept but also forbidden (as a pair or by one of its images)",
                         names[0], names[1]
                     );
                 }

@@ -104,7 +104,7 @@ pub fn plan_with(
     let graph = ViewGraph::build(&images, &pairs, options.min_num_matches);
     if graph.edges.is_empty() {
         bail!(
-            "no image pair has at least {} verified inliers (--min_num_matches)",
+            "no image pair has at least {} verified inliers (min_num_matches)",
             options.min_num_matches
         );
     }
