@@ -3,6 +3,7 @@
 
 use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, VerifiedPair};
 use crate::colmap::ids::pair_id;
+use crate::colmap::rewrite;
 use crate::costs::{self, CostModel, Costs};
 use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
 use crate::flow::search::{self, FlowRule, SearchResult};
@@ -11,6 +12,8 @@ use crate::priors::{self, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::Scene;
 use crate::selection::overrides::{Listed, Overrides};
+use crate::selection::parameters::Parameters;
+use crate::selection::preset::Preset;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -82,6 +85,22 @@ impl Plan {
 /// Reads the database and decides the selection. `stage` is told the name of each long step.
 pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Plan> {
     plan_with(db, options, &Overrides::default(), stage)
+}
+
+/// The plan of the database's last prune, recomputed from its recorded parameters (the general
+/// preset's when it was never pruned), without running a flow: its priors and costs are the ones
+/// that drove that selection. Which pairs were kept is the database's to say
+/// ([`crate::colmap::rewrite::invalidated_pairs`]).
+pub fn last_plan(db: &Database, stage: &dyn Fn(&str)) -> Result<Plan> {
+    let parameters = match rewrite::last_run::<Parameters>(db)? {
+        Some(row) => row.run.parameters,
+        None => Parameters::of_preset(Preset::General, DEFAULT_MIN_NUM_MATCHES),
+    };
+    let options = Options {
+        rule: FlowRule::Fixed(0),
+        ..parameters.options(true)
+    };
+    plan_with(db, &options, &Overrides::default(), stage)
 }
 
 /// [`plan`] honouring user overrides (see [`crate::selection::overrides`]).
