@@ -52,6 +52,7 @@ fn context_vector(
     w
 }
 
+/// Cosine similarity of two context vectors; 0 when either is all zero.
 pub fn cosine(a: &Context, b: &Context) -> f64 {
     let dot: f64 = a.iter().map(|(k, x)| x * b.get(k).unwrap_or(&0.0)).sum();
     let norm = |v: &Context| v.values().map(|x| x * x).sum::<f64>().sqrt();
@@ -61,6 +62,7 @@ pub fn cosine(a: &Context, b: &Context) -> f64 {
     }
 }
 
+/// Number of images in one context vector but not the other (the binarised vectors' distance).
 pub fn hamming(a: &Context, b: &Context) -> f64 {
     let only = |x: &Context, y: &Context| x.keys().filter(|k| !y.contains_key(k)).count();
     (only(a, b) + only(b, a)) as f64
@@ -78,6 +80,8 @@ fn inside(hull: &[[f32; 2]], p: [f32; 2]) -> bool {
     })
 }
 
+/// The three context variants of every edge, in the order `context`, `context_hamming`,
+/// `context_outside`.
 pub fn compute(scene: &Scene) -> Vec<PriorValues> {
     let features = matched_features(scene);
     let n = scene.graph.num_vertices() as f64;
