@@ -135,7 +135,7 @@ const MAX_DEPTH: f64 = 50.0;
 
 /// The pose of E on normalised correspondences, as OpenCV's `recoverPose` chooses it:
 /// `decomposeEssentialMat` gives four (R, t) candidates, tried in recoverPose's order, and the
-/// one with most points in front of both cameras (closer than [`MAX_DEPTH`]) wins. The
+/// one with most points in front of both cameras (within `MAX_DEPTH` = 50 baselines) wins. The
 /// cheirality test is done here with the closed-form [`triangulate`]: recoverPose triangulates
 /// every point of every candidate with its own SVD, which took 98% of a prune's time on 100K
 /// pairs. None when no correspondence is in front of both cameras.

@@ -1,5 +1,5 @@
 //! Pair prior: context similarity (paper, section 5.1). For pair (i, j), U_i = features of i
-//! matched in some pair but not in (i, j); w_ij[k] = number of features of U_i that match image
+//! matched in some pair but not in (i, j); `w_ij[k]` = number of features of U_i that match image
 //! k (k ≠ j). Two images of the same instance of a duplicated structure see the same context, so
 //! their context features match the same images; images of two copies do not.
 //!
