@@ -42,9 +42,6 @@ pub fn write_pruned_copy<P: Serialize>(
     result
 }
 
-/// Copies a COLMAP database for `prune --output`: SQLite's online backup API into a temporary
-/// file beside `dst`, then a rename, so `dst` is never half-written and a concurrent writer to
-/// `src` cannot tear the copy. Refuses an existing `dst` unless `overwrite`; never modifies `src`.
 /// Removes temporary copies of `dst` (and their journals) that a killed vgsel-colmap left beside
 /// it: names `.NAME.vgsel-tmp-PID…` or `..NAME.vgsel-tmp-PID…` whose process no longer runs.
 /// A SIGKILL cannot be cleaned up after at the time, so the next run does it.
@@ -76,6 +73,9 @@ pub fn remove_stale_temporaries(dst: &Path) {
     }
 }
 
+/// Copies a COLMAP database for `prune --output`: SQLite's online backup API into a temporary
+/// file beside `dst`, then a rename, so `dst` is never half-written and a concurrent writer to
+/// `src` cannot tear the copy. Refuses an existing `dst` unless `overwrite`; never modifies `src`.
 pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
     // Validates src as a COLMAP database (with the usual one-line errors) and opens it read-only.
     let source = Database::open_read_only(src)?;

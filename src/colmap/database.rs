@@ -20,21 +20,33 @@ use super::schema::{detect_layout, table_exists, Layout};
 /// matcher); long enough for a short write, short enough not to look hung.
 pub const BUSY_TIMEOUT: Duration = Duration::from_secs(5);
 
+/// A row of COLMAP's cameras table: the intrinsics that [`crate::geometry`] needs to undistort
+/// keypoints and to judge focal lengths.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
+    /// COLMAP's camera_id, which images refer to.
     pub camera_id: u32,
+    /// COLMAP's camera model number (0 SIMPLE_PINHOLE … 10); it fixes the layout of `params`.
     pub model_id: i32,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// The model's parameters in COLMAP's order (focal length(s), principal point, distortion);
+    /// the length matches the model, checked on reading.
     pub params: Vec<f64>,
     /// COLMAP's prior_focal_length: false when the focal length was only guessed.
     pub prior_focal_length: bool,
 }
 
+/// A row of COLMAP's images table: what ties an image id to its file and its camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
+    /// COLMAP's image_id, the key of keypoints and half of every pair_id.
     pub image_id: u32,
+    /// File name relative to the image folder, as COLMAP stored it.
     pub name: String,
+    /// The [`Camera`] whose intrinsics the image uses.
     pub camera_id: u32,
 }
 
@@ -42,8 +54,11 @@ pub struct Image {
 /// backup table where vgsel-colmap has invalidated it).
 #[derive(Clone, Debug, PartialEq)]
 pub struct VerifiedPair {
+    /// The smaller image id of the pair (COLMAP's pair order).
     pub image_id1: u32,
+    /// The larger image id of the pair.
     pub image_id2: u32,
+    /// COLMAP's two-view configuration (2 CALIBRATED, 3 UNCALIBRATED, 4 PLANAR, …).
     pub config: i32,
     /// Inlier correspondences: keypoint index in image_id1, keypoint index in image_id2.
     pub inliers: Vec<[u32; 2]>,
@@ -54,14 +69,23 @@ pub struct VerifiedPair {
 /// 3.8 stores all-zero qvec/tvec when it did not estimate a pose: do not trust zeros.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TwoViewGeometry {
+    /// The smaller image id of the pair (COLMAP's pair order).
     pub image_id1: u32,
+    /// The larger image id of the pair.
     pub image_id2: u32,
+    /// COLMAP's two-view configuration (2 CALIBRATED, 3 UNCALIBRATED, 4 PLANAR, …).
     pub config: i32,
+    /// Number of inlier correspondences (the row's `rows`), always > 0 here.
     pub num_inliers: usize,
+    /// Fundamental matrix, row-major, with x2^T F x1 = 0.
     pub f: Option<[f64; 9]>,
+    /// Essential matrix, row-major, with x2^T E x1 = 0 in normalised coordinates.
     pub e: Option<[f64; 9]>,
+    /// Homography, row-major, mapping image_id1's pixels to image_id2's.
     pub h: Option<[f64; 9]>,
+    /// Rotation of the relative pose cam2_from_cam1 as a unit quaternion (w, x, y, z).
     pub qvec: Option<[f64; 4]>,
+    /// Translation of cam2_from_cam1, of arbitrary scale (two views cannot fix it).
     pub tvec: Option<[f64; 3]>,
 }
 
@@ -122,6 +146,8 @@ fn image_id_of(value: i64, what: &dyn Fn() -> String) -> Result<u32> {
     u32::try_from(value).map_err(|_| anyhow!("{}: image id {value} out of range", what()))
 }
 
+/// An open COLMAP database and its detected [`Layout`]: the only way the crate reads one, so
+/// every read checks sizes and ids and reports errors naming the file.
 pub struct Database {
     conn: Connection,
     path: PathBuf,
@@ -135,6 +161,7 @@ impl Database {
     pub fn open(path: &Path) -> Result<Database> {
         Self::open_with_lock_timeout(path, false, BUSY_TIMEOUT)
     }
+    /// Like [`Database::open`] but read-only, for commands that must not change the file.
     pub fn open_read_only(path: &Path) -> Result<Database> {
         Self::open_with_lock_timeout(path, true, BUSY_TIMEOUT)
     }
@@ -184,12 +211,15 @@ impl Database {
         })
     }
 
+    /// The file's path as given, for messages.
     pub fn path(&self) -> &Path {
         &self.path
     }
+    /// The optional columns and tables this database has, detected when it was opened.
     pub fn layout(&self) -> &Layout {
         &self.layout
     }
+    /// Whether it was opened read-only, so writers can refuse early with a clear message.
     pub fn is_read_only(&self) -> bool {
         self.read_only
     }
@@ -204,6 +234,7 @@ impl Database {
         &mut self.conn
     }
 
+    /// Every camera, by camera_id; fails on an unknown model or a params blob of the wrong size.
     pub fn cameras(&self) -> Result<Vec<Camera>> {
         let p = &self.path;
         let mut stmt = self
@@ -252,6 +283,7 @@ impl Database {
         Ok(out)
     }
 
+    /// Every image, by image_id.
     pub fn images(&self) -> Result<Vec<Image>> {
         let p = &self.path;
         let mut stmt = self

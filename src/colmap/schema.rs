@@ -46,6 +46,7 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// Whether two_view_geometries has `column` (a member of [`TWO_VIEW_COLUMNS`]).
     pub fn has_two_view_column(&self, column: &str) -> bool {
         self.two_view_columns.contains(&column)
     }

@@ -11,6 +11,7 @@ use crate::selection::pipeline::Plan;
 use std::collections::{BTreeMap, HashSet};
 use std::fmt::Write;
 
+/// The graph file format `export` writes (`--format`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
     /// Graphviz DOT (removed pairs dashed).
@@ -57,8 +58,11 @@ struct Graph {
 /// What an export wrote, for the command's summary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Exported {
+    /// Nodes written: the view graph's images.
     pub images: usize,
+    /// Edges written: the view graph's pairs, kept or removed.
     pub pairs: usize,
+    /// Edges the database still has valid (not in `vgsel_backup`).
     pub pairs_kept: usize,
 }
 

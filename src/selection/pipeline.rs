@@ -24,8 +24,11 @@ pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;
 
 /// What the pipeline runs with (built from [`crate::selection::parameters::Parameters`]).
 pub struct Options {
+    /// A pair is a view-graph edge when it has at least this many verified inliers.
     pub min_num_matches: usize,
+    /// How the flow F is chosen: fixed, or searched against the image and pair criteria.
     pub rule: FlowRule,
+    /// The priors, their g and weights, and the fitness floor that make the arc costs.
     pub model: CostModel,
     /// Also compute the model's priors of weight 0 (they do not change the costs): for
     /// `--scores`. Otherwise they are skipped, which matters at scale (multiple motions run a
@@ -38,34 +41,47 @@ pub struct Options {
 /// Seconds spent in each stage.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Timings {
+    /// Reading the database and loading the scene.
     pub read: f64,
+    /// Computing the priors and costs.
     pub priors: f64,
+    /// The flow search.
     pub solve: f64,
+    /// Rewriting the database; 0 in the plan, set by `prune` after it writes.
     pub write: f64,
+    /// Wall time of the whole run so far (the plan's stages, plus `write` once written).
     pub total: f64,
 }
 
 /// Everything decided before writing.
 pub struct Plan {
+    /// Every image of the database, by image_id.
     pub images: Vec<Image>,
+    /// Every verified pair as originally verified, including those below `min_num_matches`.
     pub pairs: Vec<VerifiedPair>,
+    /// The view graph of `pairs`; its vertex and edge order index the priors, costs and search.
     pub graph: ViewGraph,
     /// Raw prior values, indexed like the graph's vertices (image priors) or edges (pair priors).
     pub image_priors: Vec<PriorValues>,
+    /// Raw pair prior values, one per edge (only the priors computed; see `unweighted_priors`).
     pub pair_priors: Vec<PriorValues>,
+    /// Arc costs and each prior's fitness, from `image_priors` and `pair_priors`.
     pub costs: Costs,
     /// Focal lengths estimated where the database had only a guess.
     pub focal_estimates: Vec<FocalEstimate>,
     /// The network the flow ran on (the view graph less the overrides' arcs).
     pub network: Restriction,
+    /// The overrides applied, by name, for the report.
     pub overrides: Listed,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
-    /// The fitness floor applied ([`fitness_floor`]) and the edges it left out of the network.
+    /// The fitness floor applied (see [`fitness_floor`]).
     pub fitness_floor: f64,
+    /// Free edges (neither kept nor forbidden) below `fitness_floor`, taken out of the network.
     pub below_fitness_floor: usize,
     /// pair_ids of the view-graph edges the selection leaves out.
     pub invalidate: Vec<u64>,
+    /// Seconds per stage, for the report.
     pub timings: Timings,
 }
 
