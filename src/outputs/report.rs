@@ -228,11 +228,31 @@ impl Report {
     }
 }
 
+/// Mean of the values that are numbers: a NaN fitness means the prior does not apply to that item
+/// (no triangle, no second motion), and the cost leaves it out too. No items: 0; items but none
+/// the prior applies to: NaN (null in the JSON).
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    if n == 0 {
-        0.0
-    } else {
-        sum / n as f64
+    let (mut sum, mut n, mut items) = (0.0, 0usize, 0usize);
+    for v in values {
+        items += 1;
+        if !v.is_nan() {
+            sum += v;
+            n += 1;
+        }
+    }
+    match (items, n) {
+        (0, _) => 0.0,
+        (_, 0) => f64::NAN,
+        _ => sum / n as f64,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn means_leave_out_priors_that_do_not_apply() {
+        assert_eq!(super::mean([0.5, f64::NAN, 1.0].into_iter()), 0.75);
+        assert!(super::mean([f64::NAN].into_iter()).is_nan());
+        assert_eq!(super::mean(std::iter::empty()), 0.0);
     }
 }
