@@ -371,3 +371,29 @@ fn colmap38_refuses_a_colmap4_database() {
     assert_eq!(dump(&db, "two_view_geometries"), original);
     assert_eq!(read42(f, &db), before);
 }
+
+/// The Python recipe (examples/pycolmap_pipeline.py, docs/colmap4.md): pycolmap extracts and
+/// matches, vgsel-colmap prunes the database file, pycolmap's mapper reads the kept pairs.
+#[test]
+fn python_recipe_prunes_between_matching_and_mapping() {
+    let Some(f) = fixture() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path().join("work");
+    let mut cmd = Command::new(&f.python);
+    cmd.arg(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/pycolmap_pipeline.py"
+    ))
+    .args([f.images.as_os_str(), work.as_os_str()])
+    .args(["--vgsel", env!("CARGO_BIN_EXE_vgsel-colmap")])
+    .args(["--max_features", "1024", "--", "--preset", "disambiguation"]);
+    let summary: Value = serde_json::from_slice(&run(cmd).stdout).unwrap();
+    let n = |k: &str| summary[k].as_u64().unwrap();
+    assert!(n("pairs_selected") < n("pairs_total"), "{summary}");
+    assert_eq!(n("registered"), 20, "{summary}");
+    let db = work.join("database.db");
+    let inspect = ok(&["inspect", "--json", "--database_path", s(&db)]);
+    let inspect: Value = serde_json::from_slice(&inspect.stdout).unwrap();
+    assert_eq!(inspect["pruned_by_vgsel_colmap"], true, "{inspect}");
+    assert!(work.join("sparse/0/images.bin").exists());
+}
