@@ -358,6 +358,11 @@ fn colmap38_refuses_a_colmap4_database() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("SQL logic error"));
     assert_eq!(user_version(&db), 3800);
+    assert_eq!(schema(&db), schema(&f.db42));
+    assert_eq!(
+        dump(&db, "two_view_geometries"),
+        dump(&f.db42, "two_view_geometries")
+    );
     let original = dump(&db, "two_view_geometries");
     ok(&[
         "prune",
