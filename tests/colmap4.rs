@@ -164,6 +164,48 @@ fn usable(pair: &Value) -> bool {
         && pair["inliers"].as_array().unwrap().len() >= 15
 }
 
+/// `vgsel-colmap prune --preset disambiguation` of `db` with `extra` options (in place without
+/// `--output`).
+fn prune(db: &Path, extra: &[&str]) {
+    let args = [
+        "prune",
+        "-q",
+        "--preset",
+        "disambiguation",
+        "--database_path",
+        s(db),
+    ];
+    ok(&[&args[..], extra].concat());
+}
+
+fn restore(db: &Path) {
+    ok(&["restore", "-q", "--database_path", s(db)]);
+}
+
+/// Lets COLMAP 4.2 open `db` (and so migrate it).
+fn open42(f: &Fixture, db: &Path) {
+    colmap4(&f.python, &[Path::new("open"), db]);
+}
+
+/// Two copies of the 3.8 database in `dir`: what COLMAP 4.2 makes of the untouched original (a
+/// copy it opened), and a copy pruned in place at 3.8.
+fn migrated_and_pruned(f: &Fixture, dir: &Path) -> (PathBuf, PathBuf) {
+    let migrated = copy(&f.db38, dir, "migrated.db");
+    open42(f, &migrated);
+    assert_eq!(user_version(&migrated), 4_020_100);
+    let pruned = copy(&f.db38, dir, "db.db");
+    prune(&pruned, &[]);
+    (migrated, pruned)
+}
+
+/// Asserts two databases hold the same two_view_geometries rows, value and storage class.
+fn assert_same_pairs(a: &Path, b: &Path) {
+    assert_eq!(
+        dump(a, "two_view_geometries"),
+        dump(b, "two_view_geometries")
+    );
+}
+
 #[test]
 fn pycolmap_database_prunes_maps_both_ways_and_restores_byte_for_byte() {
     let Some(f) = fixture() else { return };
@@ -173,18 +215,7 @@ fn pycolmap_database_prunes_maps_both_ways_and_restores_byte_for_byte() {
     let pruned = dir.join("pruned.db");
     let kept = dir.join("kept.txt");
     ok(&["inspect", "--database_path", s(&full)]);
-    ok(&[
-        "prune",
-        "-q",
-        "--preset",
-        "disambiguation",
-        "--database_path",
-        s(&full),
-        "--output",
-        s(&pruned),
-        "--pairs_out",
-        s(&kept),
-    ]);
+    prune(&full, &["--output", s(&pruned), "--pairs_out", s(&kept)]);
     // COLMAP 4.2 reads exactly the kept pairs as usable.
     let names: std::collections::HashMap<String, u64> = rusqlite::Connection::open(&full)
         .unwrap()
@@ -223,11 +254,8 @@ fn pycolmap_database_prunes_maps_both_ways_and_restores_byte_for_byte() {
     assert_eq!(registered, 20);
 
     // COLMAP 4.2 opened the pruned copy (same schema): restore is byte for byte.
-    ok(&["restore", "-q", "--database_path", s(&pruned)]);
-    assert_eq!(
-        dump(&pruned, "two_view_geometries"),
-        dump(&full, "two_view_geometries")
-    );
+    restore(&pruned);
+    assert_same_pairs(&pruned, &full);
     assert_eq!(schema(&pruned), schema(&full));
 }
 
@@ -236,20 +264,7 @@ fn restore_after_colmap4_migrated_a_pruned_38_database() {
     let Some(f) = fixture() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    // What COLMAP 4.2 makes of the untouched original.
-    let migrated = copy(&f.db38, dir, "migrated.db");
-    colmap4(&f.python, &[Path::new("open"), &migrated]);
-    assert_eq!(user_version(&migrated), 4_020_100);
-
-    let db = copy(&f.db38, dir, "db.db");
-    ok(&[
-        "prune",
-        "-q",
-        "--preset",
-        "disambiguation",
-        "--database_path",
-        s(&db),
-    ]);
+    let (migrated, db) = migrated_and_pruned(f, dir);
     // 3.8's placeholder poses went into the backup, where COLMAP's migration does not see them.
     let placeholders: i64 = rusqlite::Connection::open(&db)
         .unwrap()
@@ -268,12 +283,9 @@ fn restore_after_colmap4_migrated_a_pruned_38_database() {
     eprintln!("global mapper, COLMAP 3.8's database: full {full_correct} of 20 correct, pruned {correct} of {registered}");
     assert_eq!(registered, 20);
     assert_eq!(user_version(&db), 4_020_100);
-    ok(&["restore", "-q", "--database_path", s(&db)]);
+    restore(&db);
     // COLMAP's migrated form of every original row, byte for byte, and read the same by 4.2.
-    assert_eq!(
-        dump(&db, "two_view_geometries"),
-        dump(&migrated, "two_view_geometries")
-    );
+    assert_same_pairs(&db, &migrated);
     assert_eq!(read42(f, &db), read42(f, &migrated));
     assert!(read42(f, &db).iter().all(|p| p["cam2_from_cam1"].is_null()));
 }
@@ -283,20 +295,9 @@ fn prune_after_colmap4_migration_then_restore() {
     let Some(f) = fixture() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let migrated = copy(&f.db38, dir, "migrated.db");
-    colmap4(&f.python, &[Path::new("open"), &migrated]);
-
     // Pruned at 3.8, migrated, pruned again: the second prune starts from COLMAP's migrated rows.
-    let db = copy(&f.db38, dir, "db.db");
-    ok(&[
-        "prune",
-        "-q",
-        "--preset",
-        "disambiguation",
-        "--database_path",
-        s(&db),
-    ]);
-    colmap4(&f.python, &[Path::new("open"), &db]);
+    let (migrated, db) = migrated_and_pruned(f, dir);
+    open42(f, &db);
     ok(&["prune", "-q", "--database_path", s(&db)]);
     let versions: Vec<i64> = rusqlite::Connection::open(&db)
         .unwrap()
@@ -307,29 +308,16 @@ fn prune_after_colmap4_migration_then_restore() {
         .map(Result::unwrap)
         .collect();
     assert_eq!(versions, [3800, 4_020_100]);
-    colmap4(&f.python, &[Path::new("open"), &db]);
-    ok(&["restore", "-q", "--database_path", s(&db)]);
-    assert_eq!(
-        dump(&db, "two_view_geometries"),
-        dump(&migrated, "two_view_geometries")
-    );
+    open42(f, &db);
+    restore(&db);
+    assert_same_pairs(&db, &migrated);
 
     // Pruned after the migration: nothing changes the schema in between, so byte for byte.
     let after = copy(&migrated, dir, "after.db");
-    ok(&[
-        "prune",
-        "-q",
-        "--preset",
-        "disambiguation",
-        "--database_path",
-        s(&after),
-    ]);
-    colmap4(&f.python, &[Path::new("open"), &after]);
-    ok(&["restore", "-q", "--database_path", s(&after)]);
-    assert_eq!(
-        dump(&after, "two_view_geometries"),
-        dump(&migrated, "two_view_geometries")
-    );
+    prune(&after, &[]);
+    open42(f, &after);
+    restore(&after);
+    assert_same_pairs(&after, &migrated);
     assert_eq!(read42(f, &after), read42(f, &migrated));
 }
 
@@ -359,21 +347,10 @@ fn colmap38_refuses_a_colmap4_database() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("SQL logic error"));
     assert_eq!(user_version(&db), 3800);
     assert_eq!(schema(&db), schema(&f.db42));
-    assert_eq!(
-        dump(&db, "two_view_geometries"),
-        dump(&f.db42, "two_view_geometries")
-    );
-    let original = dump(&db, "two_view_geometries");
-    ok(&[
-        "prune",
-        "-q",
-        "--preset",
-        "disambiguation",
-        "--database_path",
-        s(&db),
-    ]);
-    ok(&["restore", "-q", "--database_path", s(&db)]);
-    assert_eq!(dump(&db, "two_view_geometries"), original);
+    assert_same_pairs(&db, &f.db42);
+    prune(&db, &[]);
+    restore(&db);
+    assert_same_pairs(&db, &f.db42);
     assert_eq!(read42(f, &db), before);
 }
 
