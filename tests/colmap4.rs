@@ -5,17 +5,15 @@
 //! COLMAP and shared by the tests; about a minute on 2 cores, most of it COLMAP 3.8's matching.
 //! Without the venv the tests fail under CI (`CI` set) and are skipped, saying so, elsewhere.
 
-mod common;
-
-use common::{dump, ok, schema, user_version};
+use crate::support::{dump, ok, schema, user_version};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
-use vgsel_colmap::render::{Scene, SceneKind};
+use vgsel_colmap::eval::render::{Scene, SceneKind};
 
-const HELPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/colmap4.py");
+const HELPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/ci/colmap4.py");
 
 /// The venv's python, or None (after saying why) when it is missing outside CI.
 fn python() -> Option<PathBuf> {
@@ -36,13 +34,13 @@ fn python() -> Option<PathBuf> {
     None
 }
 
-/// Runs scripts/colmap4.py with the venv's python and returns its stdout.
+/// Runs scripts/ci/colmap4.py with the venv's python and returns its stdout.
 fn colmap4(python: &Path, args: &[&Path]) -> String {
     let out = Command::new(python)
         .arg(HELPER)
         .args(args)
         .output()
-        .expect("running scripts/colmap4.py");
+        .expect("running scripts/ci/colmap4.py");
     assert!(
         out.status.success(),
         "colmap4.py {args:?} failed:\n{}",
@@ -230,7 +228,7 @@ fn pycolmap_database_prunes_maps_both_ways_and_restores_byte_for_byte() {
         .lines()
         .map(|l| {
             let (a, b) = l.split_once(' ').unwrap();
-            vgsel_colmap::database::pair_id(names[a] as u32, names[b] as u32)
+            vgsel_colmap::colmap::database::pair_id(names[a] as u32, names[b] as u32)
         })
         .collect();
     let read: BTreeSet<u64> = read42(f, &pruned)

@@ -2,9 +2,7 @@
 //! the database is in WAL mode (as COLMAP 3.8 and 4 leave theirs) or uses a rollback journal:
 //! no `-wal`, `-shm`, `-journal` or temporary copies.
 
-mod common;
-
-use common::{exec, ok};
+use crate::support::{exec, ok};
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -37,14 +35,14 @@ fn no_command_leaves_stray_files() {
         let tmp = tempfile::tempdir().unwrap();
         let dir = tmp.path();
         let db = dir.join("scene.db");
-        let spec = vgsel_colmap::synth::SceneSpec {
+        let spec = vgsel_colmap::eval::synth::SceneSpec {
             num_images: 16,
             num_points: 3000,
             seed: 3,
             ..Default::default()
         };
-        let truth = vgsel_colmap::synth::generate(&spec, &db).unwrap();
-        vgsel_colmap::synth::write_gt_model(&truth, &dir.join("gt")).unwrap();
+        let truth = vgsel_colmap::eval::synth::generate(&spec, &db).unwrap();
+        vgsel_colmap::eval::synth::write_gt_model(&truth, &dir.join("gt")).unwrap();
         exec(&db, &format!("PRAGMA journal_mode = {mode}"));
         let journal: String = rusqlite::Connection::open(&db)
             .unwrap()

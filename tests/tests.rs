@@ -5,6 +5,7 @@ mod support;
 
 mod architecture;
 mod cli;
+mod colmap4;
 mod crash;
 mod database;
 mod e2e;
@@ -18,5 +19,6 @@ mod rewrite;
 mod search;
 mod separation;
 mod solver;
+mod stray_files;
 mod synth;
 mod ux;

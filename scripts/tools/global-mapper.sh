@@ -4,9 +4,9 @@
 # 20 rendered images once with COLMAP 3.8 (the database COLMAP 4 then migrates) and once with
 # pycolmap 4.2, prunes a copy of each, maps all four databases and scores them against the
 # ground truth. Prints one row per database and the medians; writes WORKDIR/global.json.
-# usage: scripts/global-mapper.sh [WORKDIR] [RUNS]   (defaults: target/global-mapper, 5)
+# usage: scripts/tools/global-mapper.sh [WORKDIR] [RUNS]   (defaults: target/global-mapper, 5)
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 work=${1:-target/global-mapper}
 runs=${2:-5}
 bin=${VGSEL:-target/release/vgsel-colmap}
@@ -30,12 +30,12 @@ for run in $(seq 1 "$runs"); do
       nice colmap exhaustive_matcher --database_path "$dir/full.db" --SiftMatching.use_gpu 0 \
         >"$dir/match.log" 2>&1
     else
-      nice "$py" scripts/colmap4.py database "$images" "$dir/full.db" --camera_params "$params" \
+      nice "$py" scripts/ci/colmap4.py database "$images" "$dir/full.db" --camera_params "$params" \
         >"$dir/match.log" 2>&1
     fi
     "$bin" prune -q --preset disambiguation --database_path "$dir/full.db" --output "$dir/pruned.db"
     for variant in full pruned; do
-      nice "$py" scripts/colmap4.py map global "$dir/$variant.db" "$images" "$dir/sparse_$variant" \
+      nice "$py" scripts/ci/colmap4.py map global "$dir/$variant.db" "$images" "$dir/sparse_$variant" \
         >"$dir/map_$variant.json" 2>"$dir/map_$variant.log"
       # eval with a baseline counts false pairs; the full database is its own baseline.
       "$bin" eval --model "$dir/sparse_$variant" --ground_truth "$work/scene/gt" \

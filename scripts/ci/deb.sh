@@ -4,7 +4,7 @@
 # completions and the README; dependencies on the OpenCV libraries it links come from
 # dpkg-shlibdeps, `colmap` is recommended (Cargo.toml, [package.metadata.deb]). Prints the path.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 command -v cargo-deb >/dev/null || cargo install cargo-deb --locked --quiet
 cargo build --release --quiet
 assets=target/deb-assets

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Builds the Debian package (scripts/deb.sh), installs it with apt beside Debian's colmap and
+# Builds the Debian package (scripts/ci/deb.sh), installs it with apt beside Debian's colmap and
 # runs its autopkgtest (debian/tests) against the installed files. Removes the package again
 # unless it was installed before. Needs root or sudo.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-deb=$(bash scripts/deb.sh | tail -n 1)
+cd "$(dirname "$0")/../.."
+deb=$(bash scripts/ci/deb.sh | tail -n 1)
 echo "package: $deb" >&2
 dpkg-deb --info "$deb" | sed -n '/Depends\|Recommends/p' >&2
 sudo=""
