@@ -4,14 +4,14 @@
 # unless it was installed before. Needs root or sudo.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-deb=$(bash scripts/ci/deb.sh | tail -n 1)
+deb=$(realpath "$(bash scripts/ci/deb.sh | tail -n 1)")
 echo "package: $deb" >&2
 dpkg-deb --info "$deb" | sed -n '/Depends\|Recommends/p' >&2
 sudo=""
 [ "$(id -u)" -eq 0 ] || sudo="sudo"
 installed_before=0
 dpkg -s vgsel-colmap >/dev/null 2>&1 && installed_before=1
-DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "$PWD/$deb" colmap sqlite3 >/dev/null
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "$deb" colmap sqlite3 >/dev/null
 status=0
 for t in $(sed -n 's/^Tests: *//p' debian/tests/control); do
   tmp=$(mktemp -d)

@@ -15,4 +15,4 @@ bin=target/release/vgsel-colmap
 "$bin" completions bash >"$assets/vgsel-colmap.bash"
 "$bin" completions zsh >"$assets/_vgsel-colmap"
 "$bin" completions fish >"$assets/vgsel-colmap.fish"
-cargo deb --no-build --quiet
+cargo deb --no-build --strip --quiet
