@@ -13,6 +13,7 @@ mod eval;
 mod focal;
 mod generate_graph;
 mod mapper;
+mod migration;
 mod pair_truth;
 mod reliability;
 mod rewrite;
