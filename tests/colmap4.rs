@@ -5,7 +5,7 @@
 //! COLMAP and shared by the tests; about a minute on 2 cores, most of it COLMAP 3.8's matching.
 //! Without the venv the tests fail under CI (`CI` set) and are skipped, saying so, elsewhere.
 
-use crate::support::{dump, ok, schema, user_version};
+use crate::support::{dump, ok, run_versions, schema, user_version};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -297,15 +297,7 @@ fn prune_after_colmap4_migration_then_restore() {
     let (migrated, db) = migrated_and_pruned(f, dir);
     open42(f, &db);
     ok(&["prune", "-q", "--database_path", s(&db)]);
-    let versions: Vec<i64> = rusqlite::Connection::open(&db)
-        .unwrap()
-        .prepare("SELECT user_version FROM vgsel_runs ORDER BY run_id")
-        .unwrap()
-        .query_map([], |r| r.get(0))
-        .unwrap()
-        .map(Result::unwrap)
-        .collect();
-    assert_eq!(versions, [3800, 4_020_100]);
+    assert_eq!(run_versions(&db), [Some(3800), Some(4_020_100)]);
     open42(f, &db);
     restore(&db);
     assert_same_pairs(&db, &migrated);

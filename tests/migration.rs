@@ -80,15 +80,7 @@ fn reprune_after_migration_keeps_colmap4s_form() {
     colmap4_opens(&db);
     // The second prune keeps (1, 2) and (1, 4): they come back in COLMAP 4's form.
     prune(&db, &[(1, 3)]);
-    let versions: Vec<Option<i64>> = rusqlite::Connection::open(&db)
-        .unwrap()
-        .prepare("SELECT user_version FROM vgsel_runs ORDER BY run_id")
-        .unwrap()
-        .query_map([], |r| r.get(0))
-        .unwrap()
-        .map(Result::unwrap)
-        .collect();
-    assert_eq!(versions, [Some(3800), Some(4_020_100)]);
+    assert_eq!(run_versions(&db), [Some(3800), Some(4_020_100)]);
     let now = dump(&db, "two_view_geometries");
     let want = dump(&migrated, "two_view_geometries");
     for pair in [(1, 2), (1, 4), (2, 3), (3, 4)] {
