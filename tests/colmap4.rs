@@ -228,7 +228,7 @@ fn pycolmap_database_prunes_maps_both_ways_and_restores_byte_for_byte() {
         .lines()
         .map(|l| {
             let (a, b) = l.split_once(' ').unwrap();
-            vgsel_colmap::colmap::database::pair_id(names[a] as u32, names[b] as u32)
+            vgsel_colmap::colmap::ids::pair_id(names[a] as u32, names[b] as u32)
         })
         .collect();
     let read: BTreeSet<u64> = read42(f, &pruned)

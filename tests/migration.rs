@@ -3,7 +3,8 @@
 //! the same with the real COLMAP 4.2).
 
 use crate::support::*;
-use vgsel_colmap::colmap::database::{pair_id, Database};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::ids::pair_id;
 use vgsel_colmap::colmap::rewrite::{apply, restore, RunRecord};
 
 /// What COLMAP 4.2 does to a 3.8 database when it opens it, for the values of the fixture: the
