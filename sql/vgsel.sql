@@ -20,5 +20,8 @@ CREATE TABLE IF NOT EXISTS vgsel_runs (
     images_total    INTEGER NOT NULL,
     images_selected INTEGER NOT NULL,
     pairs_total     INTEGER NOT NULL,
-    pairs_selected  INTEGER NOT NULL
+    pairs_selected  INTEGER NOT NULL,
+    -- PRAGMA user_version when the backup was taken: a restore after COLMAP 4 migrated the
+    -- file replays the migration on the backup (src/migration.rs). Added to older runs tables.
+    user_version    INTEGER
 );

@@ -338,3 +338,15 @@ pub fn random_problem(
     let image_costs = (0..n).map(|_| -rng.gen::<f64>() * scale).collect();
     SelectionProblem { image_costs, pairs }
 }
+
+/// `vgsel_runs.user_version` of every run, oldest first.
+pub fn run_versions(path: &Path) -> Vec<Option<i64>> {
+    Connection::open(path)
+        .unwrap()
+        .prepare("SELECT user_version FROM vgsel_runs ORDER BY run_id")
+        .unwrap()
+        .query_map([], |r| r.get(0))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect()
+}

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Installs the system packages vgsel-colmap's tests, demo and benchmarks use (Debian/Ubuntu):
 # COLMAP 3.8 (real mapper runs in tests), sqlite3 (inspection in scripts), graphviz (the export
-# test renders the DOT file with `dot`), python3 (the tables of scripts/pipeline.sh), and OpenCV
-# with clang/libclang, which the `opencv` crate's build links against and generates bindings with.
+# test renders the DOT file with `dot`), python3 (the tables of scripts/pipeline.sh) and
+# python3-venv (the pycolmap venv of scripts/ci/pycolmap-venv.sh), and OpenCV with
+# clang/libclang, which the `opencv` crate's build links against and generates bindings with.
 # Does nothing for packages already installed; needs root or sudo otherwise.
 set -euo pipefail
-packages=(colmap sqlite3 bc graphviz python3 libopencv-dev clang libclang-dev)
+packages=(colmap sqlite3 bc graphviz python3 python3-venv libopencv-dev clang libclang-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -7,6 +7,9 @@ bash scripts/ci/install-deps.sh
 if command -v python3 >/dev/null && ! python3 -c "import networkx" 2>/dev/null; then
   python3 -m pip install --quiet networkx
 fi
+# COLMAP 4 for tests/colmap4.rs: pycolmap, pinned, in a virtual environment of its own.
+VGSEL_PYCOLMAP_PYTHON=$(bash scripts/ci/pycolmap-venv.sh)
+export VGSEL_PYCOLMAP_PYTHON
 cargo fmt --check
 # The tool alone builds without the evaluation tooling, and none of its dependencies come along.
 cargo clippy --quiet --no-default-features --bin vgsel-colmap -- -D warnings

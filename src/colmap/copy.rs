@@ -5,7 +5,7 @@
 use crate::colmap::database::{sql_error, Database};
 use crate::colmap::rewrite::{apply, RunRecord};
 use anyhow::{anyhow, bail, Context, Result};
-use rusqlite::{Connection, OpenFlags};
+use rusqlite::OpenFlags;
 use serde::Serialize;
 use std::path::Path;
 
@@ -115,7 +115,7 @@ pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
             .backup(rusqlite::DatabaseName::Main, &tmp, None)
             .map_err(|e| anyhow!("cannot copy {} to {}: {e}", src.display(), dst.display()))?;
         // Reopen to be sure the copy is a readable database before it takes dst's name.
-        Connection::open_with_flags(&tmp, OpenFlags::SQLITE_OPEN_READ_ONLY)
+        crate::colmap::wal::open_for_reading(&tmp, OpenFlags::empty())
             .and_then(|c| c.query_row("PRAGMA quick_check", [], |r| r.get::<_, String>(0)))
             .map_err(|e| sql_error(&tmp, e))
             .and_then(|s| {

@@ -182,12 +182,6 @@ impl Database {
             Ok(m) if m.is_dir() => bail!("cannot open COLMAP database {shown}: it is a directory"),
             Ok(_) => {}
         }
-        // No SQLITE_OPEN_CREATE: a mistyped path must fail, not leave an empty database behind.
-        let mode = if read_only {
-            OpenFlags::SQLITE_OPEN_READ_ONLY
-        } else {
-            OpenFlags::SQLITE_OPEN_READ_WRITE
-        };
         let fail = |e: rusqlite::Error| {
             let msg = sql_error(path, e).to_string();
             let reason = msg
@@ -196,8 +190,16 @@ impl Database {
                 .to_string();
             anyhow!("cannot open COLMAP database {shown}: {reason}")
         };
-        let conn = Connection::open_with_flags(path, mode | OpenFlags::SQLITE_OPEN_NO_MUTEX)
-            .map_err(fail)?;
+        // No SQLITE_OPEN_CREATE: a mistyped path must fail, not leave an empty database behind.
+        let conn = if read_only {
+            crate::colmap::wal::open_for_reading(path, OpenFlags::SQLITE_OPEN_NO_MUTEX)
+        } else {
+            Connection::open_with_flags(
+                path,
+                OpenFlags::SQLITE_OPEN_READ_WRITE | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+            )
+        }
+        .map_err(fail)?;
         conn.busy_timeout(lock_timeout).map_err(fail)?;
         let layout = detect_layout(&conn).map_err(|e| match e.downcast::<rusqlite::Error>() {
             Ok(sqlite) => fail(sqlite),

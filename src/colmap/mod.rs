@@ -5,6 +5,8 @@ pub mod blob;
 pub mod copy;
 pub mod database;
 pub mod ids;
+pub mod migration;
 pub mod model;
 pub mod rewrite;
 pub mod schema;
+pub mod wal;

@@ -9,6 +9,7 @@
 
 use crate::colmap::database::{Database, SqlResult};
 use crate::colmap::ids::{image_ids, TwoViewConfig};
+use crate::colmap::migration;
 use crate::colmap::schema::{table_exists, TWO_VIEW_COLUMNS};
 use anyhow::{anyhow, bail, Result};
 use rusqlite::{Connection, Transaction, TransactionBehavior};
@@ -53,8 +54,10 @@ pub struct RunRecordRow<P> {
 
 /// Puts every backed-up row back into two_view_geometries (re-inserting rows deleted since the
 /// prune) and returns how many. Copies values column to column inside SQLite, so storage
-/// classes survive. Leaves the backup table as it is.
+/// classes survive; rows backed up before COLMAP 4 migrated the file are first given COLMAP's
+/// migrated form. Leaves the backup table otherwise as it is.
 fn put_back(conn: &Connection, columns: &[&str]) -> rusqlite::Result<usize> {
+    migration::migrate_backup_to_current(conn)?;
     let set: Vec<String> = columns.iter().map(|c| format!("{c} = b.{c}")).collect();
     conn.execute(
         &format!(
@@ -148,6 +151,7 @@ fn apply_in<P>(
     run: &RunRecord<P>,
 ) -> Result<()> {
     tx.execute_batch(VGSEL_SQL).sql(p)?;
+    migration::ensure_version_column(tx).sql(p)?;
     put_back(tx, columns).sql(p)?;
     tx.execute("DELETE FROM vgsel_backup", []).sql(p)?;
 
@@ -193,8 +197,8 @@ fn apply_in<P>(
     let count = |n: usize| n as i64;
     tx.execute(
         "INSERT INTO vgsel_runs (time, tool_version, parameters, flow, images_total, \
-         images_selected, pairs_total, pairs_selected) \
-         VALUES (strftime('%Y-%m-%dT%H:%M:%SZ', 'now'), ?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+         images_selected, pairs_total, pairs_selected, user_version) \
+         VALUES (strftime('%Y-%m-%dT%H:%M:%SZ', 'now'), ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
         rusqlite::params![
             env!("CARGO_PKG_VERSION"),
             parameters,
@@ -203,6 +207,7 @@ fn apply_in<P>(
             count(run.images_selected),
             count(run.pairs_total),
             count(run.pairs_selected),
+            migration::user_version(tx).sql(p)?,
         ],
     )
     .sql(p)?;

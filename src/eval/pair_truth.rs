@@ -138,9 +138,8 @@ pub struct PairReport {
 
 /// pair_id of every two_view_geometries row the mapper uses now (a pruned row has rows = 0).
 pub fn used_pairs(db: &Path, min_num_matches: usize) -> Result<HashSet<u64>> {
-    let conn =
-        rusqlite::Connection::open_with_flags(db, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY)
-            .with_context(|| format!("cannot open {}", db.display()))?;
+    let conn = crate::colmap::wal::open_for_reading(db, rusqlite::OpenFlags::empty())
+        .with_context(|| format!("cannot open {}", db.display()))?;
     let mut stmt = conn
         .prepare("SELECT pair_id FROM two_view_geometries WHERE rows >= ?1")
         .with_context(|| format!("{}: no two_view_geometries", db.display()))?;
