@@ -22,6 +22,6 @@ CREATE TABLE IF NOT EXISTS vgsel_runs (
     pairs_total     INTEGER NOT NULL,
     pairs_selected  INTEGER NOT NULL,
     -- PRAGMA user_version when the backup was taken: a restore after COLMAP 4 migrated the
-    -- file replays the migration on the backup (src/migration.rs). Added to older runs tables.
+    -- file replays the migration on the backup (src/colmap/migration.rs). Added to older runs tables.
     user_version    INTEGER
 );

@@ -345,7 +345,7 @@ fn colmap38_refuses_a_colmap4_database() {
     assert_eq!(read42(f, &db), before);
 }
 
-/// The Python recipe (examples/pycolmap_pipeline.py, docs/colmap4.md): pycolmap extracts and
+/// The Python recipe (scripts/pycolmap_pipeline.py, docs/colmap4.md): pycolmap extracts and
 /// matches, vgsel-colmap prunes the database file, pycolmap's mapper reads the kept pairs.
 #[test]
 fn python_recipe_prunes_between_matching_and_mapping() {
@@ -355,7 +355,7 @@ fn python_recipe_prunes_between_matching_and_mapping() {
     let mut cmd = Command::new(&f.python);
     cmd.arg(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/examples/pycolmap_pipeline.py"
+        "/scripts/pycolmap_pipeline.py"
     ))
     .args([f.images.as_os_str(), work.as_os_str()])
     .args(["--vgsel", env!("CARGO_BIN_EXE_vgsel-colmap")])
