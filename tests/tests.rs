@@ -10,6 +10,7 @@ mod e2e;
 mod eval;
 mod focal;
 mod generate_graph;
+mod hostile;
 mod mapper;
 mod pair_truth;
 mod reliability;

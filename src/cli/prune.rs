@@ -178,14 +178,14 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
             pairs_total: plan.graph.edges.len(),
             pairs_selected: plan.search.selection.pairs.iter().filter(|&&s| s).count(),
         };
+        pause_for_tests();
         let target = match &args.output {
             None => {
-                rewrite::apply(&mut db, &plan.invalidate, &run)?;
+                rewrite::apply_if_unchanged(&mut db, plan.data_version, &plan.invalidate, &run)?;
                 input.clone()
             }
             Some(out) => {
-                drop(db);
-                write_pruned_copy(input, out, &plan.invalidate, &run)?;
+                write_pruned_copy(&db, plan.data_version, out, &plan.invalidate, &run)?;
                 out.clone()
             }
         };
@@ -207,10 +207,23 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// Copies `input` to a temporary file beside `out`, prunes the copy, then renames it to `out`:
-/// `out` is never half-written, and the temporary file is removed on failure.
+/// Test hook: `VGSEL_TEST_PAUSE_BEFORE_WRITE_MS` waits that long between the plan and the write,
+/// so tests/hostile.rs can change the database in between as another program would.
+fn pause_for_tests() {
+    if let Some(ms) = std::env::var("VGSEL_TEST_PAUSE_BEFORE_WRITE_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+    {
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+    }
+}
+
+/// Copies `input` (as it was when the plan read it at `read_version`) to a temporary file
+/// beside `out`, prunes the copy, then renames it to `out`: `out` is never half-written, and the
+/// temporary file is removed on failure.
 fn write_pruned_copy(
-    input: &Path,
+    input: &Database,
+    read_version: i64,
     out: &Path,
     invalidate: &[u64],
     run: &rewrite::RunRecord<Parameters>,
@@ -222,7 +235,7 @@ fn write_pruned_copy(
     rewrite::remove_stale_temporaries(out);
     let tmp = out.with_file_name(format!(".{name}.vgsel-tmp-{}", std::process::id()));
     let result = (|| {
-        rewrite::copy_database(input, &tmp, true)?;
+        rewrite::copy_from(input, Some(read_version), &tmp, true)?;
         let mut copy = Database::open(&tmp)?;
         rewrite::apply(&mut copy, invalidate, run)?;
         drop(copy);

@@ -95,11 +95,49 @@ pub fn apply<P: Serialize>(
     invalidate: &[u64],
     run: &RunRecord<P>,
 ) -> Result<()> {
+    apply_checked(db, None, invalidate, run)
+}
+
+/// [`apply`] to a database the selection was planned on, refusing (nothing written) when another
+/// program committed a change since [`Database::data_version`] was `read_version`: the plan
+/// would overwrite that program's work with decisions made on rows it replaced.
+pub fn apply_if_unchanged<P: Serialize>(
+    db: &mut Database,
+    read_version: i64,
+    invalidate: &[u64],
+    run: &RunRecord<P>,
+) -> Result<()> {
+    apply_checked(db, Some(read_version), invalidate, run)
+}
+
+fn apply_checked<P: Serialize>(
+    db: &mut Database,
+    read_version: Option<i64>,
+    invalidate: &[u64],
+    run: &RunRecord<P>,
+) -> Result<()> {
     // Through a JSON value, whose maps are sorted: the stored text does not depend on field order.
     let parameters = serde_json::to_value(&run.parameters)?.to_string();
     write_transaction(db, |tx, columns, p| {
+        // Inside the write transaction: no other writer can commit between check and write.
+        if let Some(version) = read_version {
+            unchanged_since(tx, p, version)?;
+        }
         apply_in(tx, columns, p, invalidate, &parameters, run)
     })
+}
+
+fn unchanged_since(conn: &Connection, p: &Path, read_version: i64) -> Result<()> {
+    let now: i64 = conn
+        .pragma_query_value(None, "data_version", |r| r.get(0))
+        .sql(p)?;
+    if now != read_version {
+        bail!(
+            "{}: another program changed the database while it was being read; nothing was written (run the prune again)",
+            p.display()
+        );
+    }
+    Ok(())
 }
 
 /// Runs `body` in one IMMEDIATE transaction of a writable database and commits it; on failure
@@ -300,7 +338,19 @@ pub fn remove_stale_temporaries(dst: &Path) {
 
 pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
     // Validates src as a COLMAP database (with the usual one-line errors) and opens it read-only.
-    let source = Database::open_read_only(src)?;
+    copy_from(&Database::open_read_only(src)?, None, dst, overwrite)
+}
+
+/// [`copy_database`] from an open database; with `read_version`, only if no other program
+/// changed it since its [`Database::data_version`] was that (the copy is then exactly what was
+/// read, not a later state the plan never saw).
+pub fn copy_from(
+    source: &Database,
+    read_version: Option<i64>,
+    dst: &Path,
+    overwrite: bool,
+) -> Result<()> {
+    let src = source.path();
     if dst.is_dir() {
         bail!("cannot write {}: it is a directory", dst.display());
     }
@@ -332,10 +382,22 @@ pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
     ));
     let result = (|| -> Result<()> {
         let _ = std::fs::remove_file(&tmp);
-        source
-            .conn()
-            .backup(rusqlite::DatabaseName::Main, &tmp, None)
-            .map_err(|e| anyhow!("cannot copy {} to {}: {e}", src.display(), dst.display()))?;
+        let conn = source.conn();
+        if read_version.is_some() {
+            // One read transaction around check and copy: the backup then copies this snapshot
+            // (SQLite's backup reuses the source connection's open transaction).
+            conn.execute_batch("BEGIN").sql(src)?;
+        }
+        let copied = read_version
+            .map_or(Ok(()), |v| unchanged_since(conn, src, v))
+            .and_then(|()| {
+                conn.backup(rusqlite::DatabaseName::Main, &tmp, None)
+                    .map_err(|e| anyhow!("cannot copy {} to {}: {e}", src.display(), dst.display()))
+            });
+        if read_version.is_some() {
+            let _ = conn.execute_batch("COMMIT");
+        }
+        copied?;
         // Reopen to be sure the copy is a readable database before it takes dst's name.
         Connection::open_with_flags(&tmp, OpenFlags::SQLITE_OPEN_READ_ONLY)
             .and_then(|c| c.query_row("PRAGMA quick_check", [], |r| r.get::<_, String>(0)))

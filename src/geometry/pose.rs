@@ -226,8 +226,12 @@ pub fn pose_from_homography(
     opencv::calib3d::decompose_homography_mat(&mat3(h)?, &identity()?, &mut rs, &mut ts, &mut ns)?;
     let mut best: Option<RelativePose> = None;
     for k in 0..rs.len() {
-        let r = Rotation3::from_matrix(&matrix3(&rs.get(k)?)?);
-        let t = vector3(&ts.get(k)?)?;
+        let (r, t) = (matrix3(&rs.get(k)?)?, vector3(&ts.get(k)?)?);
+        if !(r.iter().chain(t.iter()).all(|x| x.is_finite())) {
+            continue;
+        }
+        // nalgebra's `from_matrix` iterates until convergence, forever on NaN: bounded here.
+        let r = Rotation3::from_matrix_eps(&r, 1e-12, 100, Rotation3::identity());
         let support = x1
             .iter()
             .zip(x2)
@@ -288,6 +292,20 @@ const MIN_EXPLAINED: f64 = 0.5;
 
 /// The relative pose of a verified pair; see the module docs for the order of attempts.
 pub fn pair_pose(g: &StoredGeometry) -> Result<Option<RelativePose>> {
+    // Undistortion can send a keypoint far outside the image to infinity; such a point says
+    // nothing about the pose (and OpenCV's RANSAC refuses non-finite input).
+    if !g.x1.iter().chain(g.x2).flatten().all(|x| x.is_finite()) {
+        let (x1, x2): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
+            g.x1.iter()
+                .zip(g.x2)
+                .filter(|(a, b)| a.iter().chain(b.iter()).all(|x| x.is_finite()))
+                .unzip();
+        return pair_pose(&StoredGeometry {
+            x1: &x1,
+            x2: &x2,
+            ..*g
+        });
+    }
     let n = g.x1.len();
     let config = TwoViewConfig::from_code(g.config);
     let essential = match config {
