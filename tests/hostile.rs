@@ -496,3 +496,50 @@ fn a_database_changed_between_read_and_write_is_left_as_the_other_writer_left_it
         }
     }
 }
+
+/// Runs `f` on another thread and fails the test if it takes longer than 10 s.
+fn within_seconds<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(f()));
+    rx.recv_timeout(Duration::from_secs(10))
+        .expect("did not return within 10 s")
+}
+
+#[test]
+fn pose_and_focal_computations_are_bounded_on_non_finite_matrices() {
+    use nalgebra::Matrix3;
+    use vgsel_colmap::focal::essential_residual;
+    use vgsel_colmap::geometry::{pair_pose, pose_from_homography, StoredGeometry};
+    let x1: Vec<[f64; 2]> = (0..40)
+        .map(|k| [(k as f64 * 0.37).sin() * 0.3, (k as f64 * 0.71).cos() * 0.2])
+        .collect();
+    let x2: Vec<[f64; 2]> = x1.iter().map(|p| [p[0] + 0.05, p[1] - 0.01]).collect();
+    for x in [f64::NAN, f64::INFINITY, 1e300] {
+        let m = Matrix3::from_element(x);
+        let (a, b) = (x1.clone(), x2.clone());
+        // The geometry functions themselves, not only the reader's filter, must end.
+        let pose = within_seconds(move || pose_from_homography(&m, &a, &b).map(|p| p.is_none()));
+        assert!(pose.is_ok(), "{pose:?}");
+        let r = within_seconds(move || {
+            essential_residual(&m, &Matrix3::identity(), &Matrix3::identity())
+        });
+        assert!(r.is_finite() && (0.0..=1.0).contains(&r), "{r}");
+        let (a, b) = (x1.clone(), x2.clone());
+        within_seconds(move || {
+            let mut points = a.clone();
+            points[3] = [x, 0.0];
+            pair_pose(&StoredGeometry {
+                config: 4,
+                e: Some(m),
+                f: Some(m),
+                h: Some(m),
+                k1: Matrix3::identity(),
+                k2: Matrix3::identity(),
+                x1: &points,
+                x2: &b,
+                threshold: 1e-3,
+            })
+            .unwrap();
+        });
+    }
+}
