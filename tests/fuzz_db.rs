@@ -15,10 +15,8 @@
 //! uses seed + k). A failing case's database is kept under the target directory's
 //! `fuzz-db-findings/`, and every finding becomes a test in tests/hostile.rs.
 
-mod common;
-
-use common::watchdog::{self, Run};
-use common::{content, snapshot};
+use crate::support::watchdog::{self, Run};
+use crate::support::{content, snapshot, Content};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -50,7 +48,7 @@ fn target_tmp() -> PathBuf {
 fn generated_input() -> PathBuf {
     let path = target_tmp().join("fuzz-db-generated.db");
     if !path.exists() {
-        let spec = vgsel_colmap::synth::SceneSpec {
+        let spec = vgsel_colmap::eval::synth::SceneSpec {
             num_images: 10,
             num_points: 1200,
             seed: 11,
@@ -58,7 +56,7 @@ fn generated_input() -> PathBuf {
             ..Default::default()
         };
         let tmp = target_tmp().join(format!("fuzz-db-generated.{}.db", std::process::id()));
-        vgsel_colmap::synth::generate(&spec, &tmp).unwrap();
+        vgsel_colmap::eval::synth::generate(&spec, &tmp).unwrap();
         std::fs::rename(&tmp, &path).unwrap();
     }
     path
@@ -66,7 +64,7 @@ fn generated_input() -> PathBuf {
 
 /// A COLMAP 3.8 database of 6 rendered images of the duplicate scene (1024 SIFT features,
 /// exhaustive matching), descriptors emptied to keep it small; None without `colmap`.
-fn colmap_input() -> Option<PathBuf> {
+pub fn colmap_input() -> Option<PathBuf> {
     let path = target_tmp().join("fuzz-db-colmap38.db");
     if path.exists() {
         return Some(path);
@@ -493,7 +491,8 @@ fn mutate(conn: &Connection, rng: &mut ChaCha8Rng) -> Option<String> {
                     "journal_mode WAL".to_string()
                 }
                 5 => {
-                    conn.execute_batch(vgsel_colmap::rewrite::VGSEL_SQL).ok()?;
+                    conn.execute_batch(vgsel_colmap::colmap::rewrite::VGSEL_SQL)
+                        .ok()?;
                     let rowid = some_row(conn, rng, "two_view_geometries", "1")?;
                     conn.execute(
                         "INSERT INTO vgsel_backup (pair_id, rows, cols, data, config) \
@@ -635,7 +634,7 @@ fn check(faults: &mut Vec<String>, what: &str, run: &Run) {
 }
 
 /// The logical content, or None when the (mutated) file cannot be dumped.
-fn content_of(db: &Path) -> Option<common::Content> {
+fn content_of(db: &Path) -> Option<Content> {
     std::panic::catch_unwind(|| content(db)).ok()
 }
 

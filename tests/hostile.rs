@@ -87,8 +87,12 @@ fn set_blob(db: &Path, sql: &str, blob: &[u8]) {
     Connection::open(db).unwrap().execute(sql, [blob]).unwrap();
 }
 
-const HOSTILE_FLOATS: [(&str, f64); 6] = [
+const HOSTILE_FLOATS: [(&str, f64); 7] = [
     ("NaN", f64::NAN),
+    // Every entry -1: a rank-one H, whose decomposition gave degenerate "rotations" that
+    // nalgebra's bounded-looking `from_matrix_eps` perturbed forever (found by tests/fuzz_db.rs,
+    // seed 290897).
+    ("minus one", -1.0),
     ("+inf", f64::INFINITY),
     ("-inf", f64::NEG_INFINITY),
     ("zero", 0.0),
@@ -106,6 +110,27 @@ fn the_reported_hang_nan_matrices_with_planar_configs() {
         let sql = "UPDATE two_view_geometries SET F = ?1, E = ?1, H = ?1, \
                    config = 4 + rowid % 3 WHERE rows > 0";
         set_blob(&db, sql, &nan);
+        accepted(&db);
+    }
+}
+
+#[test]
+fn fuzz_finding_rank_one_h_on_a_colmap_database() {
+    // tests/fuzz_db.rs, seed 290897: H = all -1 on a COLMAP 3.8 pair of config 6 hung the pose
+    // recovery (nalgebra's rotation fitting on the degenerate decomposition). Every verified
+    // pair's H is set so here: the rows COLMAP verified differ a little from run to run.
+    let Some(input) = crate::fuzz_db::colmap_input() else {
+        return;
+    };
+    for x in [-1.0, 0.5, f64::NAN] {
+        let dir = tempfile::tempdir().unwrap();
+        let db = dir.path().join("colmap.db");
+        std::fs::copy(&input, &db).unwrap();
+        set_blob(
+            &db,
+            "UPDATE two_view_geometries SET H = ?1 WHERE rows > 0",
+            &f64_blob(&[x; 9]),
+        );
         accepted(&db);
     }
 }
@@ -508,18 +533,22 @@ fn within_seconds<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> 
 #[test]
 fn pose_and_focal_computations_are_bounded_on_non_finite_matrices() {
     use nalgebra::Matrix3;
-    use vgsel_colmap::focal::essential_residual;
-    use vgsel_colmap::geometry::{pair_pose, pose_from_homography, StoredGeometry};
+    use vgsel_colmap::geometry::focal::essential_residual;
+    use vgsel_colmap::geometry::pose::{pair_pose, pose_from_homography, StoredGeometry};
     let x1: Vec<[f64; 2]> = (0..40)
         .map(|k| [(k as f64 * 0.37).sin() * 0.3, (k as f64 * 0.71).cos() * 0.2])
         .collect();
     let x2: Vec<[f64; 2]> = x1.iter().map(|p| [p[0] + 0.05, p[1] - 0.01]).collect();
-    for x in [f64::NAN, f64::INFINITY, 1e300] {
+    // A camera as COLMAP guesses it for 480 x 360 images: H is normalised as K⁻¹ H K.
+    let k = Matrix3::new(576.0, 0.0, 240.0, 0.0, 576.0, 180.0, 0.0, 0.0, 1.0);
+    for x in [f64::NAN, f64::INFINITY, 1e300, -1.0, 0.0] {
         let m = Matrix3::from_element(x);
-        let (a, b) = (x1.clone(), x2.clone());
-        // The geometry functions themselves, not only the reader's filter, must end.
-        let pose = within_seconds(move || pose_from_homography(&m, &a, &b).map(|p| p.is_none()));
-        assert!(pose.is_ok(), "{pose:?}");
+        for h in [m, k.try_inverse().unwrap() * m * k] {
+            let (a, b) = (x1.clone(), x2.clone());
+            // The geometry functions themselves, not only the reader's filter, must end.
+            let pose = within_seconds(move || pose_from_homography(&h, &a, &b).map(|_| ()));
+            assert!(pose.is_ok(), "{pose:?}");
+        }
         let r = within_seconds(move || {
             essential_residual(&m, &Matrix3::identity(), &Matrix3::identity())
         });

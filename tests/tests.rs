@@ -9,6 +9,7 @@ mod database;
 mod e2e;
 mod eval;
 mod focal;
+mod fuzz_db;
 mod generate_graph;
 mod hostile;
 mod mapper;
