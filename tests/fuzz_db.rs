@@ -11,7 +11,7 @@
 //! rendered images (built once with Debian's `colmap` and cached in the target directory; left
 //! out when `colmap` is not installed), and every path in `VGSEL_FUZZ_DB_INPUTS` (`:`-separated,
 //! e.g. COLMAP 4.x databases). Budget: `VGSEL_FUZZ_DB_SECONDS` (default 25, the `cargo test`
-//! run; `scripts/fuzz-db.sh SECONDS` runs longer). `VGSEL_FUZZ_DB_SEED` replays a run (case k
+//! run; `scripts/ci/fuzz-db.sh SECONDS` runs longer). `VGSEL_FUZZ_DB_SEED` replays a run (case k
 //! uses seed + k). A failing case's database is kept under the target directory's
 //! `fuzz-db-findings/`, and every finding becomes a test in tests/hostile.rs.
 

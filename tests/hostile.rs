@@ -89,9 +89,8 @@ fn set_blob(db: &Path, sql: &str, blob: &[u8]) {
 
 const HOSTILE_FLOATS: [(&str, f64); 7] = [
     ("NaN", f64::NAN),
-    // Every entry -1: a rank-one H, whose decomposition gave degenerate "rotations" that
-    // nalgebra's bounded-looking `from_matrix_eps` perturbed forever (found by tests/fuzz_db.rs,
-    // seed 290897).
+    // Every entry -1: a rank-one matrix, the fuzzer's finding (see
+    // `fuzz_finding_rank_one_h_on_a_colmap_database`).
     ("minus one", -1.0),
     ("+inf", f64::INFINITY),
     ("-inf", f64::NEG_INFINITY),

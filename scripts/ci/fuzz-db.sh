@@ -4,6 +4,6 @@
 # databases): VGSEL_FUZZ_DB_INPUTS=a.db:b.db. Replay a run: VGSEL_FUZZ_DB_SEED=N.
 # Findings' databases are kept in target/tmp/fuzz-db-findings/.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 seconds=${1:-600}
 VGSEL_FUZZ_DB_SECONDS=$seconds nice -n 5 cargo test --release --test tests fuzz_db:: -- --nocapture
