@@ -6,4 +6,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds=${1:-600}
-VGSEL_FUZZ_DB_SECONDS=$seconds nice -n 5 cargo test --release --test tests fuzz_db:: -- --nocapture
+VGSEL_FUZZ_DB_SECONDS=$seconds nice -n 5 cargo test --test tests fuzz_db:: -- --nocapture
