@@ -17,8 +17,11 @@ use serde::{Deserialize, Deserializer, Serialize};
 pub struct Trapezoid {
     /// Min-max scale the raw values to [0, 1] over all images (or pairs) first.
     pub minmax: bool,
+    /// Breakpoints k1..k6, meant non-decreasing (not checked); k1 and k6 record the domain only.
     pub k: [f64; 6],
+    /// Fitness on the plateau [k3, k4].
     pub high: f64,
+    /// Fitness outside (k2, k5), and of NaN values (a prior that does not apply).
     pub low: f64,
 }
 
@@ -73,6 +76,7 @@ impl Trapezoid {
         low: 0.0,
     };
 
+    /// Fitness of one (already scaled) value; NaN gets `low`.
     pub fn at(&self, x: f64) -> f64 {
         let [_, k2, k3, k4, k5, _] = self.k;
         let ramp = |from: f64, to: f64, x: f64| (x - from) / (to - from);
@@ -110,8 +114,11 @@ impl Trapezoid {
 /// How one prior enters the cost.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PriorModel {
+    /// The prior's name, as its [`PriorValues`] carry it and `--weights` names it.
     pub name: &'static str,
+    /// Maps the prior's raw values to fitness in [low, high].
     pub g: Trapezoid,
+    /// Relative weight in the weighted mean; at 0 the prior has no say and may go uncomputed.
     pub weight: f64,
 }
 
@@ -144,7 +151,9 @@ impl<'de> Deserialize<'de> for PriorModel {
 /// A preset: which priors, their g and weights.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CostModel {
+    /// Priors of images, which give the costs of the network's image arcs.
     pub image_priors: Vec<PriorModel>,
+    /// Priors of pairs, which give the costs of the network's pair arcs.
     pub pair_priors: Vec<PriorModel>,
     /// Scales image costs relative to pair costs (the authors ran 0, 0.5 and 1).
     pub node_constant: f64,
@@ -172,13 +181,13 @@ impl CostModel {
     }
 
     /// The `disambiguation` preset (section 5.1): pair costs from context similarity, loop
-    /// consistency and multiple motions (the two motion terms share one prior's weight and count
-    /// only where a second motion was found). Every context and loop variant is computed and
-    /// reported; only those that measurably separate true from false pairs on the generated
-    /// duplicate scene carry weight (docs/priors.md has the AUCs): `loop_fraction` (rotation and
-    /// translation consistency of triangles) and the motion terms. The context variants measured
-    /// below 0.5 AUC there and have weight 0 (set them with `--weights`). Image costs are off
-    /// (node constant 0) so that pair evidence alone decides.
+    /// consistency, unique tracks and multiple motions (the motion terms count only where a
+    /// second motion was found). Every context and loop variant is computed and reported; only
+    /// those that measurably separate true from false pairs carry weight (docs/priors.md has the
+    /// AUCs): `loop_fraction` (rotation and translation consistency of triangles) and
+    /// `unique_tracks` (share of inliers on non-confusing tracks). The context and motion terms
+    /// measured at or below about 0.5 AUC and have weight 0 (set them with `--weights`). Image
+    /// costs are off (node constant 0) so that pair evidence alone decides.
     pub fn disambiguation() -> CostModel {
         CostModel {
             image_priors: general_image_priors(),
@@ -218,7 +227,6 @@ impl CostModel {
         Ok(())
     }
 
-    /// Names of the pair priors, in cost order.
     /// Names of the pair priors to compute: those with a weight, or all of them.
     pub fn pair_prior_names(&self, unweighted: bool) -> Vec<&'static str> {
         self.pair_priors
@@ -243,9 +251,13 @@ fn general_image_priors() -> Vec<PriorModel> {
 /// Costs of every image and pair, with each prior's fitness kept for reports.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Costs {
+    /// Cost of each vertex's image arc: minus node constant × weighted mean fitness, in [-1, 0].
     pub image_costs: Vec<f64>,
+    /// Cost of each edge's pair arc: minus its weighted mean fitness, in [-1, 0].
     pub pair_costs: Vec<f64>,
+    /// Fitness of each image prior per vertex (NaN where the raw value was NaN).
     pub image_fitness: Vec<PriorValues>,
+    /// Fitness of each pair prior per edge (NaN where the prior does not apply to the pair).
     pub pair_fitness: Vec<PriorValues>,
 }
 

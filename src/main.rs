@@ -5,6 +5,7 @@ mod cli;
 use crate::cli::progress::Progress;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
+use vgsel_colmap::colmap::database::Locked;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -139,10 +140,12 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!(
-                "vgsel-colmap: error: {}",
-                format!("{e:#}").replace('\n', " ")
-            );
+            let mut message = format!("{e:#}").replace('\n', " ");
+            if e.chain().any(|c| c.is::<Locked>()) {
+                // The library cannot know the option that waits longer; the command line does.
+                message = message.replace("or wait longer)", "or wait longer with --lock_timeout)");
+            }
+            eprintln!("vgsel-colmap: error: {message}");
             ExitCode::FAILURE
         }
     }

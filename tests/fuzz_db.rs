@@ -228,7 +228,7 @@ fn set(conn: &Connection, table: &str, column: &str, rowid: i64, value: Value) -
 /// (no such row, or SQLite refused it).
 fn mutate(conn: &Connection, rng: &mut ChaCha8Rng) -> Option<String> {
     const GEOMETRY: [&str; 5] = ["F", "E", "H", "qvec", "tvec"];
-    const TABLES: [&str; 6] = vgsel_colmap::colmap::database::REQUIRED_TABLES;
+    const TABLES: [&str; 6] = vgsel_colmap::colmap::schema::REQUIRED_TABLES;
     match rng.gen_range(0..12) {
         // Values inside well-formed float64 blobs: F/E/H/qvec/tvec, camera parameters.
         0 | 1 => {

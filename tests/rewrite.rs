@@ -5,9 +5,10 @@ use rusqlite::types::Value;
 use rusqlite::Connection;
 use std::path::Path;
 use std::time::Duration;
+use vgsel_colmap::colmap::copy::copy_database;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::ids::pair_id;
-use vgsel_colmap::colmap::rewrite::{apply, copy_database, last_run, restore, RunRecord};
+use vgsel_colmap::colmap::rewrite::{apply, last_run, restore, RunRecord};
 
 fn run(n: usize) -> RunRecord<serde_json::Value> {
     RunRecord {

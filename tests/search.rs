@@ -1,31 +1,13 @@
 //! Flow search: exact smallest F meeting the criteria, capped fallback, fixed F, degenerate input.
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use std::collections::HashSet;
-use vgsel_colmap::flow::network::{PairArc, Selection, SelectionProblem};
+use vgsel_colmap::flow::network::{Selection, SelectionProblem};
 use vgsel_colmap::flow::search::{
     search, search_with_curve, targets, Criteria, FlowRule, SearchResult,
 };
 use vgsel_colmap::flow::solver::{solve, ParametricSolver};
 
 fn random_problem(n: usize, m: usize, seed: u64) -> SelectionProblem {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut seen = HashSet::new();
-    let mut pairs = Vec::with_capacity(m);
-    while pairs.len() < m {
-        let a = rng.gen_range(0..n as u32);
-        let b = rng.gen_range(0..n as u32);
-        if a != b && seen.insert((a.min(b), a.max(b))) {
-            pairs.push(PairArc {
-                i: a.min(b),
-                j: a.max(b),
-                cost: -rng.gen::<f64>(),
-            });
-        }
-    }
-    let image_costs = (0..n).map(|_| -rng.gen::<f64>()).collect();
-    SelectionProblem { image_costs, pairs }
+    crate::support::random_problem(n, m, seed, false)
 }
 
 fn counts(s: &Selection) -> (usize, usize) {

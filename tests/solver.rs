@@ -265,28 +265,7 @@ fn brute_force_rejects_a_wrong_answer() {
 }
 
 fn random_problem(n: usize, m: usize, seed: u64) -> SelectionProblem {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut seen = HashSet::new();
-    let mut pairs = Vec::with_capacity(m);
-    while pairs.len() < m {
-        let a = rng.gen_range(0..n as u32);
-        let b = rng.gen_range(0..n as u32);
-        if a != b && seen.insert((a.min(b), a.max(b))) {
-            // a quarter of the costs on a coarse grid, to create ties
-            let cost = if rng.gen_bool(0.25) {
-                -(rng.gen_range(0..=4) as f64) / 4.0
-            } else {
-                -rng.gen::<f64>()
-            };
-            pairs.push(PairArc {
-                i: a.min(b),
-                j: a.max(b),
-                cost,
-            });
-        }
-    }
-    let image_costs = (0..n).map(|_| -rng.gen::<f64>() * 0.5).collect();
-    SelectionProblem { image_costs, pairs }
+    crate::support::random_problem(n, m, seed, true)
 }
 
 #[test]

@@ -338,3 +338,37 @@ pub fn content(path: &Path) -> Content {
     let rows = tables.iter().map(|t| dump(path, t)).collect();
     (schema(path), user_version(path), rows)
 }
+
+/// A random selection problem: `n` images, `m` distinct pairs, costs in [-1, 0]. With `ties`, a
+/// quarter of the pair costs fall on a coarse grid (to create ties) and image costs are halved.
+pub fn random_problem(
+    n: usize,
+    m: usize,
+    seed: u64,
+    ties: bool,
+) -> vgsel_colmap::flow::network::SelectionProblem {
+    use rand::{Rng, SeedableRng};
+    use vgsel_colmap::flow::network::{PairArc, SelectionProblem};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut seen = std::collections::HashSet::new();
+    let mut pairs = Vec::with_capacity(m);
+    while pairs.len() < m {
+        let a = rng.gen_range(0..n as u32);
+        let b = rng.gen_range(0..n as u32);
+        if a != b && seen.insert((a.min(b), a.max(b))) {
+            let cost = if ties && rng.gen_bool(0.25) {
+                -(rng.gen_range(0..=4) as f64) / 4.0
+            } else {
+                -rng.gen::<f64>()
+            };
+            pairs.push(PairArc {
+                i: a.min(b),
+                j: a.max(b),
+                cost,
+            });
+        }
+    }
+    let scale = if ties { 0.5 } else { 1.0 };
+    let image_costs = (0..n).map(|_| -rng.gen::<f64>() * scale).collect();
+    SelectionProblem { image_costs, pairs }
+}

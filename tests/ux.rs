@@ -80,6 +80,12 @@ fn report_plots_and_pair_list_agree() {
     assert_eq!(kept, 2 * selected + 1);
 }
 
+/// `prune --output out -q` with `extra` options.
+fn prune_copy(db: &Path, out: &Path, extra: &[&str]) {
+    let base = ["prune", "--database_path", s(db), "--output", s(out), "-q"];
+    ok(&[&base[..], extra].concat());
+}
+
 fn export(db: &Path, format: &str, out: &Path) -> String {
     ok(&[
         "export",
@@ -109,18 +115,11 @@ fn exports_carry_every_edge_with_scores_and_the_prune_state() {
     let (dir, db) = scene();
     let pruned = dir.path().join("pruned.db");
     let report = dir.path().join("r.json");
-    ok(&[
-        "prune",
-        "--database_path",
-        s(&db),
-        "--output",
-        s(&pruned),
-        "--min_pairs_per_image",
-        "2",
-        "--report",
-        s(&report),
-        "-q",
-    ]);
+    prune_copy(
+        &db,
+        &pruned,
+        &["--min_pairs_per_image", "2", "--report", s(&report)],
+    );
     let r = read_json(&report);
     let (total, selected) = (
         r["pairs_total"].as_u64().unwrap(),
@@ -370,20 +369,12 @@ fn export_shows_the_costs_that_drove_the_selection() {
     let (dir, db) = scene();
     let pruned = dir.path().join("pruned.db");
     let scores = dir.path().join("scores.csv");
-    ok(&[
-        "prune",
-        "--database_path",
-        s(&db),
-        "--output",
-        s(&pruned),
-        "--preset",
-        "disambiguation",
-        "--weights",
-        "loop_fraction=2",
-        "--scores",
-        s(&scores),
-        "-q",
-    ]);
+    let disambiguation = ["--preset", "disambiguation", "--weights", "loop_fraction=2"];
+    prune_copy(
+        &db,
+        &pruned,
+        &[&disambiguation[..], &["--scores", s(&scores)]].concat(),
+    );
     let csv = std::fs::read_to_string(&scores).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let cost_column = header.iter().position(|&h| h == "cost").unwrap();

@@ -7,7 +7,9 @@ use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::rewrite;
 use vgsel_colmap::outputs::export;
+use vgsel_colmap::selection::pipeline;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -23,8 +25,10 @@ pub struct ExportArgs {
 
 pub fn run(args: &ExportArgs, quiet: bool, progress: &Progress) -> Result<()> {
     let db = Database::open_read_only(&args.database.database_path)?;
-    progress.stage("computing priors and costs");
-    let (text, counts) = export::export(&db, args.format)?;
+    let stage = |s: &str| progress.stage(s);
+    let plan = pipeline::last_plan(&db, &stage)?;
+    let removed = rewrite::invalidated_pairs(&db)?;
+    let (text, counts) = export::export(&plan, &removed, args.format);
     std::fs::write(&args.output, text)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     progress.finish();

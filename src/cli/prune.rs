@@ -7,8 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use vgsel_colmap::colmap::database::Database;
-use vgsel_colmap::colmap::rewrite;
+use vgsel_colmap::colmap::{copy, rewrite};
 use vgsel_colmap::outputs::report::{Outputs, Report};
 use vgsel_colmap::outputs::{export, plots, scores};
 use vgsel_colmap::selection::overrides::{NameList, Overrides};
@@ -185,7 +184,8 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
                 input.clone()
             }
             Some(out) => {
-                write_pruned_copy(&db, plan.data_version, out, &plan.invalidate, &run)?;
+                copy::write_pruned_copy(&db, Some(plan.data_version), out, &plan.invalidate, &run)
+                    .with_context(|| format!("cannot write --output {}", out.display()))?;
                 out.clone()
             }
         };
@@ -216,42 +216,6 @@ fn pause_for_tests() {
     {
         std::thread::sleep(std::time::Duration::from_millis(ms));
     }
-}
-
-/// Copies `input` (as it was when the plan read it at `read_version`) to a temporary file
-/// beside `out`, prunes the copy, then renames it to `out`: `out` is never half-written, and the
-/// temporary file is removed on failure.
-fn write_pruned_copy(
-    input: &Database,
-    read_version: i64,
-    out: &Path,
-    invalidate: &[u64],
-    run: &rewrite::RunRecord<Parameters>,
-) -> Result<()> {
-    let name = out
-        .file_name()
-        .context("--output names no file")?
-        .to_string_lossy();
-    rewrite::remove_stale_temporaries(out);
-    let tmp = out.with_file_name(format!(".{name}.vgsel-tmp-{}", std::process::id()));
-    let result = (|| {
-        rewrite::copy_from(input, Some(read_version), &tmp, true)?;
-        let mut copy = Database::open(&tmp)?;
-        rewrite::apply(&mut copy, invalidate, run)?;
-        drop(copy);
-        std::fs::rename(&tmp, out)
-            .with_context(|| format!("cannot move the pruned copy to {}", out.display()))
-    })()
-    .with_context(|| format!("cannot write --output {}", out.display()));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-        let journal = format!(
-            "{}-journal",
-            tmp.file_name().unwrap_or_default().to_string_lossy()
-        );
-        let _ = std::fs::remove_file(tmp.with_file_name(journal));
-    }
-    result
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {

@@ -4,14 +4,10 @@
 //! Columns are always selected by name and optional ones detected with `PRAGMA table_info`,
 //! because COLMAP adds and drops columns between versions. Errors are one line and name the file,
 //! table and ids involved, since they usually mean a corrupt or foreign database.
-//!
-//! Schema versions: `PRAGMA user_version` is read; values below 5,000,000 are accepted (0 = written
-//! by a script, 3800/3900 = COLMAP 3.x, major*1e6 + minor*1e4 + patch*100 = COLMAP 4.x and main).
-//! A value of 5,000,000 or more is a COLMAP major version we have never seen and is refused, so we
-//! never rewrite a layout whose meaning we do not know.
+//! Which layout a database has is [`super::schema`]'s to say.
 
 use anyhow::{anyhow, bail, Result};
-use rusqlite::{Connection, ErrorCode, OpenFlags, OptionalExtension};
+use rusqlite::{Connection, ErrorCode, OpenFlags};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -19,66 +15,39 @@ use std::time::Duration;
 use super::blob::{blob, decode_f64_array, decode_keypoints_xy, decode_mat3, decode_matches};
 use super::blob::{usable_mat3, usable_vec};
 use super::ids::{camera_model_name, camera_model_num_params, image_ids, pair_id, MAX_NUM_IMAGES};
+use super::schema::{detect_layout, table_exists, Layout};
 
 /// How long a statement waits for another process's lock before failing (COLMAP GUI, a running
 /// matcher); long enough for a short write, short enough not to look hung.
 pub const BUSY_TIMEOUT: Duration = Duration::from_secs(5);
 
-/// The newest COLMAP major version whose database layout is known; see the module docs.
-pub const NEWEST_KNOWN_MAJOR: i64 = 4;
-
-/// Tables every COLMAP version since 3.x has; without them the file is not a COLMAP database.
-pub const REQUIRED_TABLES: [&str; 6] = [
-    "cameras",
-    "images",
-    "keypoints",
-    "descriptors",
-    "matches",
-    "two_view_geometries",
-];
-
-/// two_view_geometries columns after pair_id, in the order the project's backup table stores
-/// them. The first four are required; the others exist depending on the COLMAP version.
-pub const TWO_VIEW_COLUMNS: [&str; 11] = [
-    "rows", "cols", "data", "config", "F", "E", "H", "qvec", "tvec", "camera1", "camera2",
-];
-
-/// Which optional parts of COLMAP's layout a database has.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Layout {
-    /// `PRAGMA user_version` (3800 for COLMAP 3.8, 0 when a script created the file).
-    pub user_version: i64,
-    /// The members of [`TWO_VIEW_COLUMNS`] that two_view_geometries has, in that order.
-    pub two_view_columns: Vec<&'static str>,
-    /// descriptors.type (COLMAP 4.0 and later).
-    pub descriptors_type: bool,
-    /// images.prior_* columns (COLMAP 3.8/3.9 and databases migrated from them).
-    pub image_priors: bool,
-    /// rigs/frames tables (COLMAP 3.12 and later).
-    pub rigs: bool,
-}
-
-impl Layout {
-    pub fn has_two_view_column(&self, column: &str) -> bool {
-        self.two_view_columns.contains(&column)
-    }
-}
-
+/// A row of COLMAP's cameras table: the intrinsics that [`crate::geometry`] needs to undistort
+/// keypoints and to judge focal lengths.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
+    /// COLMAP's camera_id, which images refer to.
     pub camera_id: u32,
+    /// COLMAP's camera model number (0 SIMPLE_PINHOLE … 10); it fixes the layout of `params`.
     pub model_id: i32,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// The model's parameters in COLMAP's order (focal length(s), principal point, distortion);
+    /// the length matches the model, checked on reading.
     pub params: Vec<f64>,
     /// COLMAP's prior_focal_length: false when the focal length was only guessed.
     pub prior_focal_length: bool,
 }
 
+/// A row of COLMAP's images table: what ties an image id to its file and its camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
+    /// COLMAP's image_id, the key of keypoints and half of every pair_id.
     pub image_id: u32,
+    /// File name relative to the image folder, as COLMAP stored it.
     pub name: String,
+    /// The [`Camera`] whose intrinsics the image uses.
     pub camera_id: u32,
 }
 
@@ -86,8 +55,11 @@ pub struct Image {
 /// backup table where vgsel-colmap has invalidated it).
 #[derive(Clone, Debug, PartialEq)]
 pub struct VerifiedPair {
+    /// The smaller image id of the pair (COLMAP's pair order).
     pub image_id1: u32,
+    /// The larger image id of the pair.
     pub image_id2: u32,
+    /// COLMAP's two-view configuration (2 CALIBRATED, 3 UNCALIBRATED, 4 PLANAR, …).
     pub config: i32,
     /// Inlier correspondences: keypoint index in image_id1, keypoint index in image_id2.
     pub inliers: Vec<[u32; 2]>,
@@ -99,25 +71,55 @@ pub struct VerifiedPair {
 /// 3.8 stores all-zero qvec/tvec when it did not estimate a pose: do not trust zeros.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TwoViewGeometry {
+    /// The smaller image id of the pair (COLMAP's pair order).
     pub image_id1: u32,
+    /// The larger image id of the pair.
     pub image_id2: u32,
+    /// COLMAP's two-view configuration (2 CALIBRATED, 3 UNCALIBRATED, 4 PLANAR, …).
     pub config: i32,
+    /// Number of inlier correspondences (the row's `rows`), always > 0 here.
     pub num_inliers: usize,
+    /// Fundamental matrix, row-major, with x2^T F x1 = 0.
     pub f: Option<[f64; 9]>,
+    /// Essential matrix, row-major, with x2^T E x1 = 0 in normalised coordinates.
     pub e: Option<[f64; 9]>,
+    /// Homography, row-major, mapping image_id1's pixels to image_id2's.
     pub h: Option<[f64; 9]>,
+    /// Rotation of the relative pose cam2_from_cam1 as a unit quaternion (w, x, y, z).
     pub qvec: Option<[f64; 4]>,
+    /// Translation of cam2_from_cam1, of arbitrary scale (two views cannot fix it).
     pub tvec: Option<[f64; 3]>,
 }
+
+/// Another process held a lock on the database for longer than the lock timeout. A type of its
+/// own so that a front end can say how to wait longer.
+#[derive(Debug)]
+pub struct Locked {
+    /// The database.
+    pub path: PathBuf,
+}
+
+impl std::fmt::Display for Locked {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: database is locked by another process (close it and retry, or wait longer)",
+            self.path.display()
+        )
+    }
+}
+
+impl std::error::Error for Locked {}
 
 /// Turns an SQLite error into a one-line message naming the file; lock and "not a database"
 /// errors get wording a user can act on.
 pub(crate) fn sql_error(path: &Path, err: rusqlite::Error) -> anyhow::Error {
     let shown = path.display();
     match err.sqlite_error_code() {
-        Some(ErrorCode::DatabaseBusy) | Some(ErrorCode::DatabaseLocked) => {
-            anyhow!("{shown}: database is locked by another process (close it and retry, or wait longer with --lock_timeout)")
+        Some(ErrorCode::DatabaseBusy) | Some(ErrorCode::DatabaseLocked) => Locked {
+            path: path.to_path_buf(),
         }
+        .into(),
         Some(ErrorCode::NotADatabase) => anyhow!("{shown}: file is not a database"),
         Some(ErrorCode::DatabaseCorrupt) => {
             anyhow!("{shown}: database file is corrupt or truncated ({err})")
@@ -156,6 +158,8 @@ fn image_id_of(value: i64, what: &dyn Fn() -> String) -> Result<u32> {
         })
 }
 
+/// An open COLMAP database and its detected [`Layout`]: the only way the crate reads one, so
+/// every read checks sizes and ids and reports errors naming the file.
 pub struct Database {
     conn: Connection,
     path: PathBuf,
@@ -169,6 +173,7 @@ impl Database {
     pub fn open(path: &Path) -> Result<Database> {
         Self::open_with_lock_timeout(path, false, BUSY_TIMEOUT)
     }
+    /// Like [`Database::open`] but read-only, for commands that must not change the file.
     pub fn open_read_only(path: &Path) -> Result<Database> {
         Self::open_with_lock_timeout(path, true, BUSY_TIMEOUT)
     }
@@ -218,12 +223,15 @@ impl Database {
         })
     }
 
+    /// The file's path as given, for messages.
     pub fn path(&self) -> &Path {
         &self.path
     }
+    /// The optional columns and tables this database has, detected when it was opened.
     pub fn layout(&self) -> &Layout {
         &self.layout
     }
+    /// Whether it was opened read-only, so writers can refuse early with a clear message.
     pub fn is_read_only(&self) -> bool {
         self.read_only
     }
@@ -245,6 +253,7 @@ impl Database {
         &mut self.conn
     }
 
+    /// Every camera, by camera_id; fails on an unknown model or a params blob of the wrong size.
     pub fn cameras(&self) -> Result<Vec<Camera>> {
         let p = &self.path;
         let mut stmt = self
@@ -293,6 +302,7 @@ impl Database {
         Ok(out)
     }
 
+    /// Every image, by image_id.
     pub fn images(&self) -> Result<Vec<Image>> {
         let p = &self.path;
         let mut stmt = self
@@ -535,75 +545,4 @@ impl Database {
             })
             .sql(&self.path)
     }
-}
-
-pub(crate) fn table_exists(conn: &Connection, name: &str) -> rusqlite::Result<bool> {
-    conn.query_row(
-        "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?1",
-        [name],
-        |_| Ok(()),
-    )
-    .optional()
-    .map(|o| o.is_some())
-}
-
-fn column_names(conn: &Connection, table: &str) -> rusqlite::Result<Vec<String>> {
-    let mut stmt = conn.prepare(&format!("PRAGMA table_info({table})"))?;
-    let names = stmt.query_map([], |r| r.get::<_, String>(1))?;
-    names.collect()
-}
-
-/// Reads user_version and the tables' columns; refuses what is not (or not yet) COLMAP.
-fn detect_layout(conn: &Connection) -> Result<Layout> {
-    let user_version: i64 = conn.pragma_query_value(None, "user_version", |r| r.get(0))?;
-    let mut stmt = conn.prepare("SELECT name FROM sqlite_master WHERE type = 'table'")?;
-    let tables: HashSet<String> = stmt
-        .query_map([], |r| r.get::<_, String>(0))?
-        .collect::<rusqlite::Result<_>>()?;
-    let missing: Vec<&str> = REQUIRED_TABLES
-        .iter()
-        .copied()
-        .filter(|t| !tables.contains(*t))
-        .collect();
-    if !missing.is_empty() {
-        bail!(
-            "not a COLMAP database: missing table{} {}",
-            if missing.len() > 1 { "s" } else { "" },
-            missing.join(", ")
-        );
-    }
-    if !(0..(NEWEST_KNOWN_MAJOR + 1) * 1_000_000).contains(&user_version) {
-        bail!(
-            "unknown schema version {user_version} (PRAGMA user_version; known: COLMAP 3.x to {NEWEST_KNOWN_MAJOR}.x); \
-             this COLMAP is newer than vgsel-colmap"
-        );
-    }
-    let tvg = column_names(conn, "two_view_geometries")?;
-    let missing: Vec<&str> = ["pair_id", "rows", "cols", "data", "config"]
-        .into_iter()
-        .filter(|c| !tvg.iter().any(|t| t == c))
-        .collect();
-    if !missing.is_empty() {
-        bail!(
-            "not a COLMAP database: two_view_geometries lacks column(s) {}",
-            missing.join(", ")
-        );
-    }
-    let two_view_columns = TWO_VIEW_COLUMNS
-        .into_iter()
-        .filter(|c| tvg.iter().any(|t| t == c))
-        .collect();
-    let descriptors_type = column_names(conn, "descriptors")?
-        .iter()
-        .any(|c| c == "type");
-    let image_priors = column_names(conn, "images")?
-        .iter()
-        .any(|c| c == "prior_qw");
-    Ok(Layout {
-        user_version,
-        two_view_columns,
-        descriptors_type,
-        image_priors,
-        rigs: tables.contains("rigs"),
-    })
 }

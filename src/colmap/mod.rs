@@ -2,7 +2,9 @@
 //! sparse models. The rest of the crate sees COLMAP only through these types.
 
 pub mod blob;
+pub mod copy;
 pub mod database;
 pub mod ids;
 pub mod model;
 pub mod rewrite;
+pub mod schema;

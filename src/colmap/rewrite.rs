@@ -7,13 +7,14 @@
 //! `vgsel_backup` (sql/vgsel.sql), whose untyped columns keep each value's storage class, so a
 //! restore is byte for byte.
 
-use crate::colmap::database::{sql_error, table_exists, Database, SqlResult, TWO_VIEW_COLUMNS};
+use crate::colmap::database::{Database, SqlResult};
 use crate::colmap::ids::{image_ids, TwoViewConfig};
+use crate::colmap::schema::{table_exists, TWO_VIEW_COLUMNS};
 use anyhow::{anyhow, bail, Result};
-use rusqlite::{Connection, OpenFlags, Transaction, TransactionBehavior};
+use rusqlite::{Connection, Transaction, TransactionBehavior};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashSet};
 use std::path::Path;
 
 /// The project's tables (CREATE TABLE IF NOT EXISTS).
@@ -127,7 +128,9 @@ fn apply_checked<P: Serialize>(
     })
 }
 
-fn unchanged_since(conn: &Connection, p: &Path, read_version: i64) -> Result<()> {
+/// Fails (one line) when another connection committed a change since `PRAGMA data_version` was
+/// `read_version`.
+pub(crate) fn unchanged_since(conn: &Connection, p: &Path, read_version: i64) -> Result<()> {
     let now: i64 = conn
         .pragma_query_value(None, "data_version", |r| r.get(0))
         .sql(p)?;
@@ -260,6 +263,25 @@ pub fn restore(db: &mut Database) -> Result<usize> {
     })
 }
 
+/// pair_ids of the pairs the database's prune invalidated (their original rows are backed up);
+/// empty when it was never pruned.
+pub fn invalidated_pairs(db: &Database) -> Result<HashSet<u64>> {
+    if !db.has_backup_table()? {
+        return Ok(HashSet::new());
+    }
+    let p = db.path();
+    let mut stmt = db
+        .conn()
+        .prepare("SELECT pair_id FROM vgsel_backup")
+        .sql(p)?;
+    let ids = stmt
+        .query_map([], |r| r.get::<_, i64>(0))
+        .sql(p)?
+        .collect::<rusqlite::Result<Vec<_>>>()
+        .sql(p)?;
+    Ok(ids.into_iter().map(|id| id as u64).collect())
+}
+
 /// The most recent prune's record, or None when the database has no runs table (never pruned,
 /// or restored since).
 pub fn last_run<P: DeserializeOwned>(db: &Database) -> Result<Option<RunRecordRow<P>>> {
@@ -300,123 +322,4 @@ pub fn last_run<P: DeserializeOwned>(db: &Database) -> Result<Option<RunRecordRo
             pairs_selected: n(8)?,
         },
     }))
-}
-
-/// Copies a COLMAP database for `prune --output`: SQLite's online backup API into a temporary
-/// file beside `dst`, then a rename, so `dst` is never half-written and a concurrent writer to
-/// `src` cannot tear the copy. Refuses an existing `dst` unless `overwrite`; never modifies `src`.
-/// Removes temporary copies of `dst` (and their journals) that a killed vgsel-colmap left beside
-/// it: names `.NAME.vgsel-tmp-PID…` or `..NAME.vgsel-tmp-PID…` whose process no longer runs.
-/// A SIGKILL cannot be cleaned up after at the time, so the next run does it.
-pub fn remove_stale_temporaries(dst: &Path) {
-    let (Some(dir), Some(name)) = (dst.parent(), dst.file_name()) else {
-        return;
-    };
-    let dir = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
-    };
-    let prefix = format!(".{}.vgsel-tmp-", name.to_string_lossy());
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let file = entry.file_name().to_string_lossy().into_owned();
-        let Some(rest) = file
-            .strip_prefix(&prefix)
-            .or_else(|| file.strip_prefix(&format!(".{prefix}")))
-        else {
-            continue;
-        };
-        let pid: String = rest.chars().take_while(char::is_ascii_digit).collect();
-        if !pid.is_empty() && !Path::new("/proc").join(&pid).exists() {
-            let _ = std::fs::remove_file(entry.path());
-        }
-    }
-}
-
-pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
-    // Validates src as a COLMAP database (with the usual one-line errors) and opens it read-only.
-    copy_from(&Database::open_read_only(src)?, None, dst, overwrite)
-}
-
-/// [`copy_database`] from an open database; with `read_version`, only if no other program
-/// changed it since its [`Database::data_version`] was that (the copy is then exactly what was
-/// read, not a later state the plan never saw).
-pub fn copy_from(
-    source: &Database,
-    read_version: Option<i64>,
-    dst: &Path,
-    overwrite: bool,
-) -> Result<()> {
-    let src = source.path();
-    if dst.is_dir() {
-        bail!("cannot write {}: it is a directory", dst.display());
-    }
-    if dst.exists() {
-        let same = match (src.canonicalize(), dst.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        };
-        if same {
-            bail!(
-                "cannot copy {} onto itself; give a different output path",
-                src.display()
-            );
-        }
-        if !overwrite {
-            bail!(
-                "output {} already exists (refusing to overwrite it)",
-                dst.display()
-            );
-        }
-    }
-    let name = dst
-        .file_name()
-        .ok_or_else(|| anyhow!("output path {} has no file name", dst.display()))?;
-    let tmp = dst.with_file_name(format!(
-        ".{}.vgsel-tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| -> Result<()> {
-        let _ = std::fs::remove_file(&tmp);
-        let conn = source.conn();
-        if read_version.is_some() {
-            // One read transaction around check and copy: the backup then copies this snapshot
-            // (SQLite's backup reuses the source connection's open transaction).
-            conn.execute_batch("BEGIN").sql(src)?;
-        }
-        let copied = read_version
-            .map_or(Ok(()), |v| unchanged_since(conn, src, v))
-            .and_then(|()| {
-                conn.backup(rusqlite::DatabaseName::Main, &tmp, None)
-                    .map_err(|e| anyhow!("cannot copy {} to {}: {e}", src.display(), dst.display()))
-            });
-        if read_version.is_some() {
-            let _ = conn.execute_batch("COMMIT");
-        }
-        copied?;
-        // Reopen to be sure the copy is a readable database before it takes dst's name.
-        Connection::open_with_flags(&tmp, OpenFlags::SQLITE_OPEN_READ_ONLY)
-            .and_then(|c| c.query_row("PRAGMA quick_check", [], |r| r.get::<_, String>(0)))
-            .map_err(|e| sql_error(&tmp, e))
-            .and_then(|s| {
-                if s == "ok" {
-                    Ok(())
-                } else {
-                    Err(anyhow!(
-                        "{}: copy failed its integrity check: {s}",
-                        tmp.display()
-                    ))
-                }
-            })?;
-        std::fs::rename(&tmp, dst)
-            .map_err(|e| anyhow!("cannot rename {} to {}: {e}", tmp.display(), dst.display()))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

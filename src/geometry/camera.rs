@@ -14,14 +14,21 @@ use opencv::core::{Mat, Point2d, Vector};
 /// One COLMAP camera as K plus OpenCV distortion coefficients.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraModel {
+    /// COLMAP's camera_id this model was made from.
     pub camera_id: u32,
+    /// Focal length along x, in pixels.
     pub fx: f64,
+    /// Focal length along y, in pixels (equal to `fx` for single-focal models).
     pub fy: f64,
+    /// Principal point x, in pixels (COLMAP's convention: 0.5 is the top-left pixel's centre).
     pub cx: f64,
+    /// Principal point y, in pixels.
     pub cy: f64,
     /// OpenCV order: k1, k2, p1, p2, k3, k4, k5, k6 (zeros where the model has none).
     pub distortion: [f64; 8],
+    /// Image width in pixels, which bounds the focal-length search.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// False when COLMAP only guessed the focal length (1.2 × max(width, height)).
     pub prior_focal_length: bool,
@@ -81,6 +88,7 @@ impl CameraModel {
         })
     }
 
+    /// The calibration matrix K (pixels from normalised coordinates), without distortion.
     pub fn k(&self) -> Matrix3<f64> {
         Matrix3::new(self.fx, 0.0, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0)
     }

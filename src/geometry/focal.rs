@@ -15,8 +15,11 @@ use rayon::prelude::*;
 /// into the camera list).
 #[derive(Clone, Debug)]
 pub struct FundamentalPair {
+    /// Camera of the first image (the one F maps from).
     pub a: usize,
+    /// Camera of the second image; may equal `a` when both images share a camera.
     pub b: usize,
+    /// The fundamental matrix in pixels, oriented a -> b.
     pub f: Matrix3<f64>,
 }
 

@@ -16,8 +16,11 @@ use opencv::prelude::*;
 /// Where a pose came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PoseSource {
+    /// The stored essential matrix (config CALIBRATED).
     Essential,
+    /// K2ᵀ F K1 from the stored fundamental matrix (config UNCALIBRATED).
     Fundamental,
+    /// The stored homography, decomposed (planar or panoramic configs).
     Homography,
     /// `findEssentialMat` on the inliers.
     Estimated,
@@ -26,10 +29,13 @@ pub enum PoseSource {
 /// cam2_from_cam1: x2 = rotation · x1 + translation (translation known up to scale).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RelativePose {
+    /// Rotation of cam2_from_cam1.
     pub rotation: Rotation3<f64>,
+    /// Direction of cam2_from_cam1's translation; unit length since its scale is unknown.
     pub translation: Unit<Vector3<f64>>,
     /// Correspondences in front of both cameras for this pose.
     pub support: usize,
+    /// Which matrix the pose was decomposed from, so reports can tell stored from re-estimated.
     pub source: PoseSource,
 }
 
@@ -129,7 +135,7 @@ const MAX_DEPTH: f64 = 50.0;
 
 /// The pose of E on normalised correspondences, as OpenCV's `recoverPose` chooses it:
 /// `decomposeEssentialMat` gives four (R, t) candidates, tried in recoverPose's order, and the
-/// one with most points in front of both cameras (closer than [`MAX_DEPTH`]) wins. The
+/// one with most points in front of both cameras (within `MAX_DEPTH` = 50 baselines) wins. The
 /// cheirality test is done here with the closed-form [`triangulate`]: recoverPose triangulates
 /// every point of every candidate with its own SVD, which took 98% of a prune's time on 100K
 /// pairs. None when no correspondence is in front of both cameras.
@@ -300,13 +306,21 @@ pub fn triangulate(
 /// What a pose is computed from: the pair's config, its stored matrices in pixels (pair order),
 /// the two calibrations, and its inliers in normalised coordinates.
 pub struct StoredGeometry<'a> {
+    /// COLMAP's two-view config, which picks the matrix to decompose (0 where none is stored).
     pub config: i32,
+    /// Stored essential matrix (normalised coordinates), None where COLMAP stored none.
     pub e: Option<Matrix3<f64>>,
+    /// Stored fundamental matrix (pixels), None where COLMAP stored none.
     pub f: Option<Matrix3<f64>>,
+    /// Stored homography (pixels, image 1 to image 2), None where COLMAP stored none.
     pub h: Option<Matrix3<f64>>,
+    /// Calibration matrix of image 1, to turn F and H into normalised coordinates.
     pub k1: Matrix3<f64>,
+    /// Calibration matrix of image 2.
     pub k2: Matrix3<f64>,
+    /// Inlier positions in image 1, normalised and undistorted.
     pub x1: &'a [[f64; 2]],
+    /// The matching inlier positions in image 2, same length and order as `x1`.
     pub x2: &'a [[f64; 2]],
     /// Epipolar threshold in normalised units (pixels / focal).
     pub threshold: f64,

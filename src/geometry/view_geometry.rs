@@ -14,6 +14,8 @@ use rayon::prelude::*;
 /// (COLMAP's `--SiftMatching.max_error` default is 4).
 pub const MAX_ERROR_PX: f64 = 4.0;
 
+/// Per-vertex cameras and keypoints and per-edge poses and homographies, computed once so the
+/// pose-based priors share them instead of each redoing the geometry.
 pub struct ViewGeometry {
     /// Camera of each vertex (focal lengths already estimated where they were only guessed).
     pub cameras: Vec<CameraModel>,

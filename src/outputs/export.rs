@@ -1,24 +1,17 @@
 //! Views of a database's view graph for other tools: Graphviz DOT and GraphML (`export`), and the
 //! kept pairs as a COLMAP pair list (`prune --pairs_out`).
 //!
-//! `export` recomputes the priors and costs with the parameters of the database's last prune
-//! (its typed run record: preset, cost model with any weight overrides, `min_num_matches`; the
-//! general preset's if it was never pruned), so the costs shown are the ones that drove the
-//! selection, and reads kept/removed from the database itself: an edge is removed when its
-//! original row is in `vgsel_backup`.
+//! `export` formats the plan of the database's last prune
+//! ([`crate::selection::pipeline::last_plan`]: its priors and costs recomputed with the recorded
+//! parameters, so they are the ones that drove the selection) with kept/removed as the database
+//! records it ([`crate::colmap::rewrite::invalidated_pairs`]).
 
-use crate::colmap::database::{Database, SqlResult};
 use crate::colmap::ids::pair_id;
-use crate::colmap::rewrite;
-use crate::flow::search::FlowRule;
-use crate::selection::overrides::Overrides;
-use crate::selection::parameters::Parameters;
-use crate::selection::pipeline::{self, Plan, DEFAULT_MIN_NUM_MATCHES};
-use crate::selection::preset::Preset;
-use anyhow::Result;
+use crate::selection::pipeline::Plan;
 use std::collections::{BTreeMap, HashSet};
 use std::fmt::Write;
 
+/// The graph file format `export` writes (`--format`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
     /// Graphviz DOT (removed pairs dashed).
@@ -65,25 +58,18 @@ struct Graph {
 /// What an export wrote, for the command's summary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Exported {
+    /// Nodes written: the view graph's images.
     pub images: usize,
+    /// Edges written: the view graph's pairs, kept or removed.
     pub pairs: usize,
+    /// Edges the database still has valid (not in `vgsel_backup`).
     pub pairs_kept: usize,
 }
 
-/// Reads `db` (never writes it) and returns the file contents in `format`.
-pub fn export(db: &Database, format: Format) -> Result<(String, Exported)> {
-    let parameters = match rewrite::last_run::<Parameters>(db)? {
-        Some(row) => row.run.parameters,
-        None => Parameters::of_preset(Preset::General, DEFAULT_MIN_NUM_MATCHES),
-    };
-    // The costs only: which pairs were kept is read from the database, so no flow runs.
-    let options = pipeline::Options {
-        rule: FlowRule::Fixed(0),
-        ..parameters.options(true)
-    };
-    let plan = pipeline::plan_with(db, &options, &Overrides::default(), &|_| {})?;
-    let removed = removed_pair_ids(db)?;
-    let graph = build(&plan, &removed);
+/// The view graph of `plan` in `format`, each pair marked removed when its pair_id is in
+/// `removed` (the database's own record of the prune) and kept otherwise.
+pub fn export(plan: &Plan, removed: &HashSet<u64>, format: Format) -> (String, Exported) {
+    let graph = build(plan, removed);
     let exported = Exported {
         images: graph.nodes.len(),
         pairs: graph.edges.len(),
@@ -93,24 +79,7 @@ pub fn export(db: &Database, format: Format) -> Result<(String, Exported)> {
         Format::Dot => dot(&graph),
         Format::Graphml => graphml(&graph),
     };
-    Ok((text, exported))
-}
-
-fn removed_pair_ids(db: &Database) -> Result<HashSet<u64>> {
-    if !db.has_backup_table()? {
-        return Ok(HashSet::new());
-    }
-    let p = db.path();
-    let mut stmt = db
-        .conn()
-        .prepare("SELECT pair_id FROM vgsel_backup")
-        .sql(p)?;
-    let ids = stmt
-        .query_map([], |r| r.get::<_, i64>(0))
-        .sql(p)?
-        .collect::<rusqlite::Result<Vec<_>>>()
-        .sql(p)?;
-    Ok(ids.into_iter().map(|id| id as u64).collect())
+    (text, exported)
 }
 
 fn edge_pair_id(plan: &Plan, pair: usize) -> u64 {

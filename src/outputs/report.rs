@@ -11,20 +11,30 @@ use std::collections::HashMap;
 /// Version of the report's layout; bumped when a field changes meaning or disappears.
 pub const SCHEMA_VERSION: u32 = 1;
 
+/// The JSON report of one prune (layout in docs/report.md), built from its [`Plan`].
 #[derive(Debug, Serialize)]
 pub struct Report {
+    /// [`SCHEMA_VERSION`], so readers can tell layouts apart.
     pub schema_version: u32,
+    /// vgsel-colmap's version (Cargo package version).
     pub tool_version: &'static str,
+    /// The input database, as given.
     pub database_path: String,
     /// Where the pruned database was written (the input itself unless `--output`); null on a dry run.
     pub output_path: Option<String>,
+    /// True when nothing was written (no output path).
     pub dry_run: bool,
+    /// The run's [`Parameters`], as recorded in the database's run record.
     pub parameters: serde_json::Value,
+    /// The total flow F of the selection.
     pub flow: u64,
     /// True when no flow met the criteria and the full view graph was kept.
     pub capped: bool,
+    /// Rows of the images table.
     pub images_total: usize,
+    /// Images with at least one view-graph edge.
     pub images_in_view_graph: usize,
+    /// View-graph images the selection uses (kept pairs' images included).
     pub images_selected: usize,
     /// Names of images without any verified pair of at least `min_num_matches` inliers.
     pub images_isolated: Vec<String>,
@@ -32,43 +42,58 @@ pub struct Report {
     pub pairs_verified: usize,
     /// View-graph edges (pairs with at least `min_num_matches` inliers).
     pub pairs_total: usize,
+    /// Edges left valid (kept pairs included).
     pub pairs_selected: usize,
+    /// Edges invalidated (or that would be, on a dry run): `pairs_total - pairs_selected`.
     pub pairs_invalidated: usize,
     /// The fitness floor applied: the cost model's `min_pair_fitness`, lowered (with a
     /// searched flow) until the image criterion's number of images keep a pair reaching it.
     pub fitness_floor: f64,
     /// Edges never offered to the flow: fitness below `fitness_floor`.
     pub pairs_below_fitness_floor: usize,
+    /// The view graph before the prune.
     pub graph_before: GraphStats,
+    /// The graph of the selected pairs; its `isolated_images` counts every image left without one.
     pub graph_after: GraphStats,
     /// Of the flow's selection, before kept pairs are added (see docs/report.md).
     pub criteria: Vec<CriterionStatus>,
+    /// Mean fitness of each prior, image priors first, to show what the selection favoured.
     pub priors: Vec<PriorSummary>,
+    /// The overrides applied, by name.
     pub overrides: Listed,
     /// Files written besides the database: filled in by the command as it writes them.
     pub outputs: Outputs,
+    /// Seconds per stage.
     pub timings: Timings,
 }
 
 /// Paths of the extra files a prune wrote (null or empty when not asked for).
 #[derive(Debug, Default, Serialize)]
 pub struct Outputs {
+    /// The `--pairs_out` pair list, if written.
     pub pairs_out: Option<String>,
+    /// The SVG plots written (`--plots`).
     pub plots: Vec<String>,
 }
 
 /// Spread of one prior's fitness over all images or pairs, and over the selected ones.
 #[derive(Debug, Serialize)]
 pub struct PriorSummary {
+    /// The prior's name, as in the cost model.
     pub name: &'static str,
+    /// `images` or `pairs`.
     pub applies_to: &'static str,
+    /// Mean fitness (after g, in [0, 1]) over all images or pairs of the view graph; NaN (JSON
+    /// null) when the prior does not apply to some of them.
     pub mean_fitness: f64,
+    /// Over the images or pairs the selection kept (0 when none).
     pub mean_fitness_selected: f64,
     /// Over the images or pairs the selection left out (0 when none).
     pub mean_fitness_removed: f64,
 }
 
 impl Report {
+    /// The report of `plan`; `output_path` None means a dry run. `outputs` starts empty.
     pub fn new(
         plan: &Plan,
         database_path: String,

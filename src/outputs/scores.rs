@@ -43,6 +43,7 @@ pub fn csv(plan: &Plan) -> String {
     out
 }
 
+/// Writes [`csv`] to `path`, replacing any existing file.
 pub fn write(plan: &Plan, path: &Path) -> Result<()> {
     std::fs::write(path, csv(plan)).with_context(|| format!("writing {}", path.display()))
 }

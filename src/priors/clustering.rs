@@ -5,6 +5,7 @@
 use super::PriorValues;
 use crate::scene::view_graph::ViewGraph;
 
+/// 1 − local clustering coefficient of every vertex: 1 for images that bridge unlinked groups.
 pub fn compute(graph: &ViewGraph) -> PriorValues {
     let values = (0..graph.num_vertices())
         .map(|v| 1.0 - graph.clustering_coefficient(v))

@@ -1,5 +1,5 @@
 //! Pair prior: context similarity (paper, section 5.1). For pair (i, j), U_i = features of i
-//! matched in some pair but not in (i, j); w_ij[k] = number of features of U_i that match image
+//! matched in some pair but not in (i, j); `w_ij[k]` = number of features of U_i that match image
 //! k (k ≠ j). Two images of the same instance of a duplicated structure see the same context, so
 //! their context features match the same images; images of two copies do not.
 //!
@@ -52,6 +52,7 @@ fn context_vector(
     w
 }
 
+/// Cosine similarity of two context vectors; 0 when either is all zero.
 pub fn cosine(a: &Context, b: &Context) -> f64 {
     let dot: f64 = a.iter().map(|(k, x)| x * b.get(k).unwrap_or(&0.0)).sum();
     let norm = |v: &Context| v.values().map(|x| x * x).sum::<f64>().sqrt();
@@ -61,6 +62,7 @@ pub fn cosine(a: &Context, b: &Context) -> f64 {
     }
 }
 
+/// Number of images in one context vector but not the other (the binarised vectors' distance).
 pub fn hamming(a: &Context, b: &Context) -> f64 {
     let only = |x: &Context, y: &Context| x.keys().filter(|k| !y.contains_key(k)).count();
     (only(a, b) + only(b, a)) as f64
@@ -78,6 +80,8 @@ fn inside(hull: &[[f32; 2]], p: [f32; 2]) -> bool {
     })
 }
 
+/// The three context variants of every edge, in the order `context`, `context_hamming`,
+/// `context_outside`.
 pub fn compute(scene: &Scene) -> Vec<PriorValues> {
     let features = matched_features(scene);
     let n = scene.graph.num_vertices() as f64;

@@ -29,6 +29,8 @@ pub fn score(h: &Matrix3<f64>) -> f64 {
     (h.transpose() * h - Matrix3::identity()).norm().min(2.0)
 }
 
+/// [`score`] of each edge's stored (else fitted) homography; 1 where there is none or it has
+/// at most [`MIN_HOMOGRAPHY_INLIERS`] inliers.
 pub fn compute(scene: &Scene, geometry: &ViewGeometry) -> Result<PriorValues> {
     let values = (0..scene.graph.edges.len())
         .into_par_iter()

@@ -3,6 +3,7 @@
 use super::PriorValues;
 use crate::scene::Scene;
 
+/// Number of verified inliers of every edge.
 pub fn compute(scene: &Scene) -> PriorValues {
     let values = scene
         .graph

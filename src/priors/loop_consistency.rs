@@ -39,6 +39,8 @@ pub fn triangle_errors(ab: &RelativePose, bc: &RelativePose, ac: &RelativePose) 
     (rotation_angle_deg(&chained), coplanar)
 }
 
+/// `loop` and `loop_fraction` of every edge from the edges' poses (`poses[edge]`, i -> j);
+/// `loop_fraction` is NaN for a pair in no triangle whose three poses are known.
 pub fn compute(scene: &Scene, poses: &[Option<RelativePose>]) -> Vec<PriorValues> {
     let graph = scene.graph;
     let index: HashMap<(u32, u32), usize> = graph

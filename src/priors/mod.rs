@@ -4,7 +4,8 @@
 //!
 //! The `general` preset (paper, section 5.2) uses the image priors degree, track fraction and
 //! clustering, and the pair priors inliers, overlap, triangulation angle and homography; the
-//! `disambiguation` preset (section 5.1) the pair priors context, loop and multiple motions.
+//! `disambiguation` preset (section 5.1) the pair priors context, loop and multiple motions,
+//! and unique tracks (beyond the paper).
 //! [`pairs::compute`] computes the pair priors a cost model names.
 
 pub mod clustering;
@@ -25,7 +26,9 @@ use crate::scene::Scene;
 /// Raw values of one prior: one per vertex (image prior) or per edge (pair prior).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PriorValues {
+    /// The prior's name, which [`crate::costs::PriorModel::name`] matches it by.
     pub name: &'static str,
+    /// One raw value per vertex or edge, in graph order; NaN where the prior does not apply.
     pub values: Vec<f64>,
 }
 

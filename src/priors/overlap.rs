@@ -6,6 +6,8 @@ use super::PriorValues;
 use crate::scene::Scene;
 use rayon::prelude::*;
 
+/// Mean over the edge's two images of inlier hull area / image area, each capped at 1; 0 when
+/// the inliers span no area.
 pub fn compute(scene: &Scene) -> PriorValues {
     let values = (0..scene.graph.edges.len())
         .into_par_iter()

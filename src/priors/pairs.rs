@@ -16,13 +16,20 @@ use std::collections::HashMap;
 /// A focal length estimated for a camera that had only a guess.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct FocalEstimate {
+    /// The camera whose focal length was estimated.
     pub camera_id: u32,
+    /// The database's focal length (fx) in pixels, COLMAP's guess.
     pub guessed: f64,
+    /// The focal length in pixels the poses were computed with instead.
     pub estimated: f64,
 }
 
+/// What [`compute`] returns: the pair priors, and the focal lengths it estimated on the way so
+/// the report can show them.
 pub struct PairPriors {
+    /// Raw values of each prior computed, one per edge.
     pub values: Vec<PriorValues>,
+    /// One entry per camera whose guessed focal length was replaced (empty without pose priors).
     pub focal_estimates: Vec<FocalEstimate>,
 }
 

@@ -4,6 +4,8 @@
 use super::PriorValues;
 use crate::scene::Scene;
 
+/// Share in [0, 1] of each vertex's keypoints that are an inlier of some edge (0 without
+/// keypoints).
 pub fn compute(scene: &Scene) -> PriorValues {
     let mut in_track: Vec<Vec<bool>> = scene
         .keypoints

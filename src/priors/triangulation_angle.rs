@@ -9,6 +9,7 @@ use crate::geometry::view_geometry::ViewGeometry;
 use crate::scene::Scene;
 use rayon::prelude::*;
 
+/// Median triangulation angle (degrees) of each edge's inliers; 0 without a pose or points.
 pub fn compute(scene: &Scene, geometry: &ViewGeometry) -> PriorValues {
     let values = (0..scene.graph.edges.len())
         .into_par_iter()

@@ -17,6 +17,7 @@ use petgraph::unionfind::UnionFind;
 /// A track with more observations than this many times the median is confusing.
 pub const CONFUSING_FACTOR: u32 = 4;
 
+/// Share in [0, 1] of each edge's inliers on tracks that are not confusing (0 without inliers).
 pub fn compute(scene: &Scene) -> PriorValues {
     let graph = scene.graph;
     // One union-find element per keypoint of every vertex.

@@ -9,16 +9,21 @@ use serde::Serialize;
 /// One edge: vertex indices `i < j` and the verified pair it came from.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Edge {
+    /// The lower vertex index (the image with the smaller image_id).
     pub i: u32,
+    /// The higher vertex index; every edge has `i < j`, the flow network's arc direction.
     pub j: u32,
     /// Index into the `pairs` slice given to [`ViewGraph::build`].
     pub pair: usize,
 }
 
+/// Images and the verified pairs `colmap mapper` would use, as an undirected graph: what the
+/// selection chooses a subgraph of.
 #[derive(Clone, Debug)]
 pub struct ViewGraph {
     /// image_id of each vertex, ascending. Only images with at least one edge are vertices.
     pub image_ids: Vec<u32>,
+    /// Every edge, sorted by (i, j); an edge's index is what per-edge vectors are indexed by.
     pub edges: Vec<Edge>,
     /// Images without any edge: reported, left alone.
     pub isolated: Vec<u32>,
@@ -29,13 +34,21 @@ pub struct ViewGraph {
 /// Figures `inspect` and the report show.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct GraphStats {
+    /// Vertices: images with at least one edge.
     pub images: usize,
+    /// Images with no edge, not counted in `images`.
     pub isolated_images: usize,
+    /// Edges: verified pairs with enough inliers.
     pub pairs: usize,
+    /// Connected components of the graph (isolated images not counted).
     pub components: usize,
+    /// Smallest vertex degree (0 for an empty graph).
     pub degree_min: usize,
+    /// Median vertex degree (mean of the middle two for an even count).
     pub degree_median: f64,
+    /// Mean vertex degree.
     pub degree_mean: f64,
+    /// Largest vertex degree.
     pub degree_max: usize,
 }
 
@@ -87,14 +100,17 @@ impl ViewGraph {
         }
     }
 
+    /// Number of vertices (images with at least one edge).
     pub fn num_vertices(&self) -> usize {
         self.image_ids.len()
     }
 
+    /// Number of edges at vertex `v`.
     pub fn degree(&self, v: usize) -> usize {
         self.neighbours[v].len()
     }
 
+    /// The vertices joined to `v` by an edge, ascending.
     pub fn neighbours(&self, v: usize) -> &[u32] {
         &self.neighbours[v]
     }
@@ -136,6 +152,7 @@ impl ViewGraph {
         components
     }
 
+    /// Size, connectivity and degree figures of the graph, for `inspect` and the report.
     pub fn stats(&self) -> GraphStats {
         let mut degrees: Vec<usize> = (0..self.num_vertices()).map(|v| self.degree(v)).collect();
         degrees.sort_unstable();

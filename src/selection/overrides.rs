@@ -25,7 +25,9 @@ use std::path::{Path, PathBuf};
 /// One list file as read: each entry with its 1-based line number.
 #[derive(Clone, Debug)]
 pub struct NameList {
+    /// The file read, for error messages and the run record.
     pub path: PathBuf,
+    /// (line number, names): two names per pair-list entry, one per image-list entry.
     pub entries: Vec<(usize, Vec<String>)>,
 }
 
@@ -66,18 +68,24 @@ impl NameList {
 /// The override files given on the command line (each optional).
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
+    /// `--keep_pairs`: pairs added to the selection whatever the flow does.
     pub keep_pairs: Option<NameList>,
+    /// `--forbid_pairs`: pairs never selected.
     pub forbid_pairs: Option<NameList>,
+    /// `--forbid_images`: images taken out of the network with all their pairs.
     pub forbid_images: Option<NameList>,
 }
 
 /// The overrides as listed in the report, by image name.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Listed {
+    /// Kept pairs, names as given in the file.
     pub keep_pairs: Vec<[String; 2]>,
+    /// Forbidden pairs, names as given in the file (view-graph edges or not).
     pub forbid_pairs: Vec<[String; 2]>,
     /// Forbidden pairs that are no view-graph edge: never selected anyway.
     pub forbid_pairs_not_in_view_graph: usize,
+    /// Forbidden image names, as given (isolated images included).
     pub forbid_images: Vec<String>,
     /// Pairs taken out of the network because one of their images is forbidden.
     pub pairs_of_forbidden_images: usize,
@@ -90,6 +98,7 @@ pub struct Resolved {
     pub edges: Vec<ArcRule>,
     /// Indexed like `ViewGraph::image_ids`.
     pub forbidden_vertices: Vec<bool>,
+    /// What was resolved, by name, for the report.
     pub listed: Listed,
 }
 
@@ -178,7 +187,7 @@ impl Overrides {
                 };
                 if edges[k] == ArcRule::Removed {
                     bail!(
-                        "{where_}: `{}` `{}` is kept but also forbidden (--forbid_pairs or --forbid_images)",
+                        "{where_}: `{}` `{}` is kept but also forbidden (as a pair or by one of its images)",
                         names[0], names[1]
                     );
                 }

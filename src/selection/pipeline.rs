@@ -3,6 +3,7 @@
 
 use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, VerifiedPair};
 use crate::colmap::ids::pair_id;
+use crate::colmap::rewrite;
 use crate::costs::{self, CostModel, Costs};
 use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
 use crate::flow::search::{self, FlowRule, SearchResult};
@@ -11,6 +12,8 @@ use crate::priors::{self, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::Scene;
 use crate::selection::overrides::{Listed, Overrides};
+use crate::selection::parameters::Parameters;
+use crate::selection::preset::Preset;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -21,8 +24,11 @@ pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;
 
 /// What the pipeline runs with (built from [`crate::selection::parameters::Parameters`]).
 pub struct Options {
+    /// A pair is a view-graph edge when it has at least this many verified inliers.
     pub min_num_matches: usize,
+    /// How the flow F is chosen: fixed, or searched against the image and pair criteria.
     pub rule: FlowRule,
+    /// The priors, their g and weights, and the fitness floor that make the arc costs.
     pub model: CostModel,
     /// Also compute the model's priors of weight 0 (they do not change the costs): for
     /// `--scores`. Otherwise they are skipped, which matters at scale (multiple motions run a
@@ -35,34 +41,47 @@ pub struct Options {
 /// Seconds spent in each stage.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Timings {
+    /// Reading the database and loading the scene.
     pub read: f64,
+    /// Computing the priors and costs.
     pub priors: f64,
+    /// The flow search.
     pub solve: f64,
+    /// Rewriting the database; 0 in the plan, set by `prune` after it writes.
     pub write: f64,
+    /// Wall time of the whole run so far (the plan's stages, plus `write` once written).
     pub total: f64,
 }
 
 /// Everything decided before writing.
 pub struct Plan {
+    /// Every image of the database, by image_id.
     pub images: Vec<Image>,
+    /// Every verified pair as originally verified, including those below `min_num_matches`.
     pub pairs: Vec<VerifiedPair>,
+    /// The view graph of `pairs`; its vertex and edge order index the priors, costs and search.
     pub graph: ViewGraph,
     /// Raw prior values, indexed like the graph's vertices (image priors) or edges (pair priors).
     pub image_priors: Vec<PriorValues>,
+    /// Raw pair prior values, one per edge (only the priors computed; see `unweighted_priors`).
     pub pair_priors: Vec<PriorValues>,
+    /// Arc costs and each prior's fitness, from `image_priors` and `pair_priors`.
     pub costs: Costs,
     /// Focal lengths estimated where the database had only a guess.
     pub focal_estimates: Vec<FocalEstimate>,
     /// The network the flow ran on (the view graph less the overrides' arcs).
     pub network: Restriction,
+    /// The overrides applied, by name, for the report.
     pub overrides: Listed,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
-    /// The fitness floor applied ([`fitness_floor`]) and the edges it left out of the network.
+    /// The fitness floor applied (see [`fitness_floor`]).
     pub fitness_floor: f64,
+    /// Free edges (neither kept nor forbidden) below `fitness_floor`, taken out of the network.
     pub below_fitness_floor: usize,
     /// pair_ids of the view-graph edges the selection leaves out.
     pub invalidate: Vec<u64>,
+    /// Seconds per stage, for the report.
     pub timings: Timings,
     /// The database's [`Database::data_version`] before anything was read: the write refuses a
     /// database another program changed since.
@@ -87,6 +106,22 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
     plan_with(db, options, &Overrides::default(), stage)
 }
 
+/// The plan of the database's last prune, recomputed from its recorded parameters (the general
+/// preset's when it was never pruned), without running a flow: its priors and costs are the ones
+/// that drove that selection. Which pairs were kept is the database's to say
+/// ([`crate::colmap::rewrite::invalidated_pairs`]).
+pub fn last_plan(db: &Database, stage: &dyn Fn(&str)) -> Result<Plan> {
+    let parameters = match rewrite::last_run::<Parameters>(db)? {
+        Some(row) => row.run.parameters,
+        None => Parameters::of_preset(Preset::General, DEFAULT_MIN_NUM_MATCHES),
+    };
+    let options = Options {
+        rule: FlowRule::Fixed(0),
+        ..parameters.options(true)
+    };
+    plan_with(db, &options, &Overrides::default(), stage)
+}
+
 /// [`plan`] honouring user overrides (see [`crate::selection::overrides`]).
 pub fn plan_with(
     db: &Database,
@@ -108,7 +143,7 @@ pub fn plan_with(
     let graph = ViewGraph::build(&images, &pairs, options.min_num_matches);
     if graph.edges.is_empty() {
         bail!(
-            "no image pair has at least {} verified inliers (--min_num_matches)",
+            "no image pair has at least {} verified inliers (min_num_matches)",
             options.min_num_matches
         );
     }
