@@ -2,33 +2,14 @@
 //! error line naming the problem and exit status 1 (or behaves as documented), never panics, and
 //! leaves every file in the database's directory byte for byte as it was whenever it fails.
 
-use crate::support::{dump, exec, fixture, ok, scene, table_names, vgsel, Layout};
+use crate::support::{dump, exec, fixture, ok, scene, snapshot, table_names, vgsel, Layout};
 use rusqlite::Connection;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 use tempfile::TempDir;
 use vgsel_colmap::colmap::ids::image_ids;
 use vgsel_colmap::eval::synth::{generate, SceneSpec};
-
-/// Every file under `dir` (names relative to it) with its bytes.
-fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut todo = vec![dir.to_path_buf()];
-    while let Some(d) = todo.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                todo.push(path);
-            } else {
-                let bytes = std::fs::read(&path).unwrap();
-                out.insert(path.strip_prefix(dir).unwrap().to_path_buf(), bytes);
-            }
-        }
-    }
-    out
-}
 
 /// The exit status and stderr of a failed run; asserts status 1, no panic, and that the last
 /// stderr line is the only error line.

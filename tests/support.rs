@@ -2,6 +2,8 @@
 //! tables exactly (value and SQLite storage class) for byte-for-byte comparisons.
 #![allow(dead_code)]
 
+pub mod watchdog;
+
 use rusqlite::types::Value;
 use rusqlite::{params, Connection};
 use std::path::{Path, PathBuf};
@@ -303,6 +305,38 @@ pub fn scene() -> (TempDir, PathBuf) {
     )
     .unwrap();
     (dir, db)
+}
+
+/// Every file under `dir` (names relative to it) with its bytes.
+pub fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                todo.push(path);
+            } else {
+                let bytes = std::fs::read(&path).unwrap();
+                out.insert(path.strip_prefix(dir).unwrap().to_path_buf(), bytes);
+            }
+        }
+    }
+    out
+}
+
+/// The whole logical content: the schema, `PRAGMA user_version` and every table dumped, for
+/// "exactly as before" checks that do not depend on the file's page layout.
+pub type Content = (
+    Vec<(String, String, String, Option<String>)>,
+    i64,
+    Vec<Vec<Row>>,
+);
+
+pub fn content(path: &Path) -> Content {
+    let tables = table_names(path);
+    let rows = tables.iter().map(|t| dump(path, t)).collect();
+    (schema(path), user_version(path), rows)
 }
 
 /// A random selection problem: `n` images, `m` distinct pairs, costs in [-1, 0]. With `ties`, a

@@ -177,14 +177,14 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
             pairs_total: plan.graph.edges.len(),
             pairs_selected: plan.search.selection.pairs.iter().filter(|&&s| s).count(),
         };
+        pause_for_tests();
         let target = match &args.output {
             None => {
-                rewrite::apply(&mut db, &plan.invalidate, &run)?;
+                rewrite::apply_if_unchanged(&mut db, plan.data_version, &plan.invalidate, &run)?;
                 input.clone()
             }
             Some(out) => {
-                drop(db);
-                copy::write_pruned_copy(input, out, &plan.invalidate, &run)
+                copy::write_pruned_copy(&db, Some(plan.data_version), out, &plan.invalidate, &run)
                     .with_context(|| format!("cannot write --output {}", out.display()))?;
                 out.clone()
             }
@@ -205,6 +205,17 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         eprintln!("{}", report.summary());
     }
     Ok(())
+}
+
+/// Test hook: `VGSEL_TEST_PAUSE_BEFORE_WRITE_MS` waits that long between the plan and the write,
+/// so tests/hostile.rs can change the database in between as another program would.
+fn pause_for_tests() {
+    if let Some(ms) = std::env::var("VGSEL_TEST_PAUSE_BEFORE_WRITE_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+    {
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+    }
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {

@@ -113,6 +113,29 @@ pub fn decode_mat3(what: &str, data: Option<&[u8]>) -> Result<Option<[f64; 9]>> 
     decode_f64_array::<9>(what, data)
 }
 
+/// A stored F, E or H as something to compute with: None (taken as missing, the pose is then
+/// estimated from the inliers) when a value is NaN or infinite or all are zero. The three are
+/// defined only up to scale: one whose largest entry is beyond 2^±300 (where products of its
+/// entries overflow or vanish) is scaled to a largest entry of ±1. NaN and infinite values made
+/// nalgebra's unbounded iterations (rotation fitting, SVD) run forever.
+pub fn usable_mat3(m: Option<[f64; 9]>) -> Option<[f64; 9]> {
+    let m = m?;
+    let largest = m
+        .iter()
+        .try_fold(0.0f64, |acc, x| x.is_finite().then(|| acc.max(x.abs())))?;
+    const LIMIT: f64 = 2.037035976334486e90; // 2^300
+    match largest {
+        0.0 => None,
+        l if (1.0 / LIMIT..=LIMIT).contains(&l) => Some(m),
+        l => Some(m.map(|x| x / l)),
+    }
+}
+
+/// A stored qvec (non-zero) or tvec: None when a value is NaN or infinite, or the qvec is zero.
+pub fn usable_vec<const N: usize>(v: Option<[f64; N]>) -> Option<[f64; N]> {
+    v.filter(|v| v.iter().all(|x| x.is_finite()) && (N != 4 || v.iter().any(|&x| x != 0.0)))
+}
+
 /// float32 values as a blob (keypoints: x, y[, a11, a12, a21, a22] per row).
 pub fn encode_f32(values: &[f32]) -> Vec<u8> {
     values.iter().flat_map(|v| v.to_le_bytes()).collect()

@@ -2,17 +2,20 @@
 //! `prune --output`, the pruned copy (copy beside the target, prune it, rename), and the clean-up
 //! of temporaries a killed run left behind.
 
-use crate::colmap::database::{sql_error, Database};
-use crate::colmap::rewrite::{apply, RunRecord};
+use crate::colmap::database::{sql_error, Database, SqlResult};
+use crate::colmap::rewrite::{apply, unchanged_since, RunRecord};
 use anyhow::{anyhow, bail, Context, Result};
 use rusqlite::OpenFlags;
 use serde::Serialize;
 use std::path::Path;
 
 /// Copies `input` to a temporary file beside `out`, prunes the copy, then renames it to `out`:
-/// `out` is never half-written, and the temporary file is removed on failure.
+/// `out` is never half-written, and the temporary file is removed on failure. With
+/// `read_version` (the [`Database::data_version`] a plan read the input at) the copy is refused
+/// when another program changed the input since, so it is exactly what the plan saw.
 pub fn write_pruned_copy<P: Serialize>(
-    input: &Path,
+    input: &Database,
+    read_version: Option<i64>,
     out: &Path,
     invalidate: &[u64],
     run: &RunRecord<P>,
@@ -24,7 +27,7 @@ pub fn write_pruned_copy<P: Serialize>(
     remove_stale_temporaries(out);
     let tmp = out.with_file_name(format!(".{name}.vgsel-tmp-{}", std::process::id()));
     let result = (|| {
-        copy_database(input, &tmp, true)?;
+        copy_from(input, read_version, &tmp, true)?;
         let mut copy = Database::open(&tmp)?;
         apply(&mut copy, invalidate, run)?;
         drop(copy);
@@ -78,7 +81,18 @@ pub fn remove_stale_temporaries(dst: &Path) {
 /// `src` cannot tear the copy. Refuses an existing `dst` unless `overwrite`; never modifies `src`.
 pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
     // Validates src as a COLMAP database (with the usual one-line errors) and opens it read-only.
-    let source = Database::open_read_only(src)?;
+    copy_from(&Database::open_read_only(src)?, None, dst, overwrite)
+}
+
+/// [`copy_database`] from an open database; with `read_version`, only if no other program
+/// changed it since its [`Database::data_version`] was that.
+fn copy_from(
+    source: &Database,
+    read_version: Option<i64>,
+    dst: &Path,
+    overwrite: bool,
+) -> Result<()> {
+    let src = source.path();
     if dst.is_dir() {
         bail!("cannot write {}: it is a directory", dst.display());
     }
@@ -110,10 +124,22 @@ pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
     ));
     let result = (|| -> Result<()> {
         let _ = std::fs::remove_file(&tmp);
-        source
-            .conn()
-            .backup(rusqlite::DatabaseName::Main, &tmp, None)
-            .map_err(|e| anyhow!("cannot copy {} to {}: {e}", src.display(), dst.display()))?;
+        let conn = source.conn();
+        if read_version.is_some() {
+            // One read transaction around check and copy: the backup then copies this snapshot
+            // (SQLite's backup reuses the source connection's open transaction).
+            conn.execute_batch("BEGIN").sql(src)?;
+        }
+        let copied = read_version
+            .map_or(Ok(()), |v| unchanged_since(conn, src, v))
+            .and_then(|()| {
+                conn.backup(rusqlite::DatabaseName::Main, &tmp, None)
+                    .map_err(|e| anyhow!("cannot copy {} to {}: {e}", src.display(), dst.display()))
+            });
+        if read_version.is_some() {
+            let _ = conn.execute_batch("COMMIT");
+        }
+        copied?;
         // Reopen to be sure the copy is a readable database before it takes dst's name.
         crate::colmap::wal::open_for_reading(&tmp, OpenFlags::empty())
             .and_then(|c| c.query_row("PRAGMA quick_check", [], |r| r.get::<_, String>(0)))

@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use super::blob::{blob, decode_f64_array, decode_keypoints_xy, decode_mat3, decode_matches};
-use super::ids::{camera_model_name, camera_model_num_params, image_ids, pair_id};
+use super::blob::{usable_mat3, usable_vec};
+use super::ids::{camera_model_name, camera_model_num_params, image_ids, pair_id, MAX_NUM_IMAGES};
 use super::schema::{detect_layout, table_exists, Layout};
 
 /// How long a statement waits for another process's lock before failing (COLMAP GUI, a running
@@ -65,7 +66,8 @@ pub struct VerifiedPair {
 }
 
 /// The geometry of a verified pair (as originally verified), without its inliers. Matrices are
-/// in pair order (image_id1 -> image_id2); `None` where COLMAP stored nothing (NULL or empty).
+/// in pair order (image_id1 -> image_id2); `None` where COLMAP stored nothing (NULL or empty)
+/// or nothing usable ([`super::blob::usable_mat3`], [`super::blob::usable_vec`]).
 /// 3.8 stores all-zero qvec/tvec when it did not estimate a pose: do not trust zeros.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TwoViewGeometry {
@@ -142,8 +144,18 @@ impl<T> SqlResult<T> for rusqlite::Result<T> {
     }
 }
 
+/// An image id as COLMAP can pair it: below [`MAX_NUM_IMAGES`], or pair_ids would be ambiguous.
 fn image_id_of(value: i64, what: &dyn Fn() -> String) -> Result<u32> {
-    u32::try_from(value).map_err(|_| anyhow!("{}: image id {value} out of range", what()))
+    u32::try_from(value)
+        .ok()
+        .filter(|&id| (id as u64) < MAX_NUM_IMAGES)
+        .ok_or_else(|| {
+            anyhow!(
+                "{}: image id {value} out of range (COLMAP allows 0 to {})",
+                what(),
+                MAX_NUM_IMAGES - 1
+            )
+        })
 }
 
 /// An open COLMAP database and its detected [`Layout`]: the only way the crate reads one, so
@@ -228,6 +240,13 @@ impl Database {
     /// Changes how long statements wait for another process's lock (default [`BUSY_TIMEOUT`]).
     pub fn set_busy_timeout(&self, timeout: Duration) -> Result<()> {
         self.conn.busy_timeout(timeout).sql(&self.path)
+    }
+    /// SQLite's `PRAGMA data_version`: changes exactly when another connection (this process
+    /// or another) commits a change to the file, in rollback-journal and WAL mode alike.
+    pub fn data_version(&self) -> Result<i64> {
+        self.conn
+            .pragma_query_value(None, "data_version", |r| r.get(0))
+            .sql(&self.path)
     }
     pub(crate) fn conn(&self) -> &Connection {
         &self.conn
@@ -341,7 +360,21 @@ impl Database {
         };
         let what = || format!("keypoints of image {image_id}");
         let data = blob(row.get_ref(2).sql(p)?, &what)?;
-        decode_keypoints_xy(image_id, row.get(0).sql(p)?, row.get(1).sql(p)?, data)
+        let xy = decode_keypoints_xy(image_id, row.get(0).sql(p)?, row.get(1).sql(p)?, data)?;
+        // Negative or outside the image is accepted (other extractors write such positions);
+        // NaN or infinite is no position at all.
+        if let Some(k) = xy
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            bail!(
+                "{}: keypoint {k} is at ({}, {}), not a finite position",
+                what(),
+                xy[k][0],
+                xy[k][1]
+            );
+        }
+        Ok(xy)
     }
 
     /// Whether the project's backup table exists (even if empty).
@@ -388,6 +421,14 @@ impl Database {
         let id = u64::try_from(raw)
             .map_err(|_| anyhow!("two_view_geometries: negative pair_id {raw}"))?;
         let (a, b) = image_ids(id);
+        // Beyond 2147483647 x 2147483647 the first id does not fit: the ids would name other
+        // images, and the write would touch another row.
+        if pair_id(a, b) != id {
+            bail!("two_view_geometries: pair_id {id} is not the pair_id of two image ids");
+        }
+        if a == b {
+            bail!("two_view_geometries pair_id {id} pairs image {a} with itself");
+        }
         for image in [a, b] {
             if !images.contains(&image) {
                 bail!(
@@ -456,11 +497,11 @@ impl Database {
                 image_id2: b,
                 config: row.get(2).sql(p)?,
                 num_inliers: n as usize,
-                f: decode_mat3(&what("F"), get(3, "F")?)?,
-                e: decode_mat3(&what("E"), get(4, "E")?)?,
-                h: decode_mat3(&what("H"), get(5, "H")?)?,
-                qvec: decode_f64_array::<4>(&what("qvec"), get(6, "qvec")?)?,
-                tvec: decode_f64_array::<3>(&what("tvec"), get(7, "tvec")?)?,
+                f: usable_mat3(decode_mat3(&what("F"), get(3, "F")?)?),
+                e: usable_mat3(decode_mat3(&what("E"), get(4, "E")?)?),
+                h: usable_mat3(decode_mat3(&what("H"), get(5, "H")?)?),
+                qvec: usable_vec(decode_f64_array::<4>(&what("qvec"), get(6, "qvec")?)?),
+                tvec: usable_vec(decode_f64_array::<3>(&what("tvec"), get(7, "tvec")?)?),
             });
         }
         Ok(out)

@@ -99,11 +99,51 @@ pub fn apply<P: Serialize>(
     invalidate: &[u64],
     run: &RunRecord<P>,
 ) -> Result<()> {
+    apply_checked(db, None, invalidate, run)
+}
+
+/// [`apply`] to a database the selection was planned on, refusing (nothing written) when another
+/// program committed a change since [`Database::data_version`] was `read_version`: the plan
+/// would overwrite that program's work with decisions made on rows it replaced.
+pub fn apply_if_unchanged<P: Serialize>(
+    db: &mut Database,
+    read_version: i64,
+    invalidate: &[u64],
+    run: &RunRecord<P>,
+) -> Result<()> {
+    apply_checked(db, Some(read_version), invalidate, run)
+}
+
+fn apply_checked<P: Serialize>(
+    db: &mut Database,
+    read_version: Option<i64>,
+    invalidate: &[u64],
+    run: &RunRecord<P>,
+) -> Result<()> {
     // Through a JSON value, whose maps are sorted: the stored text does not depend on field order.
     let parameters = serde_json::to_value(&run.parameters)?.to_string();
     write_transaction(db, |tx, columns, p| {
+        // Inside the write transaction: no other writer can commit between check and write.
+        if let Some(version) = read_version {
+            unchanged_since(tx, p, version)?;
+        }
         apply_in(tx, columns, p, invalidate, &parameters, run)
     })
+}
+
+/// Fails (one line) when another connection committed a change since `PRAGMA data_version` was
+/// `read_version`.
+pub(crate) fn unchanged_since(conn: &Connection, p: &Path, read_version: i64) -> Result<()> {
+    let now: i64 = conn
+        .pragma_query_value(None, "data_version", |r| r.get(0))
+        .sql(p)?;
+    if now != read_version {
+        bail!(
+            "{}: another program changed the database while it was being read; nothing was written (run the prune again)",
+            p.display()
+        );
+    }
+    Ok(())
 }
 
 /// Runs `body` in one IMMEDIATE transaction of a writable database and commits it; on failure

@@ -39,6 +39,9 @@ impl CameraModel {
     /// and FOV models have no OpenCV `undistortPoints` equivalent and are refused.
     pub fn from_colmap(c: &Camera) -> Result<CameraModel> {
         let p = &c.params;
+        if let Some(k) = p.iter().position(|x| !x.is_finite()) {
+            bail!("camera {}: parameter {k} is {}", c.camera_id, p[k]);
+        }
         let mut d = [0.0; 8];
         let (fx, fy, cx, cy) = match c.model_id {
             0 => (p[0], p[0], p[1], p[2]),
@@ -67,7 +70,10 @@ impl CameraModel {
             ),
         };
         if !(fx > 0.0 && fy > 0.0) {
-            bail!("camera {}: focal length must be positive", c.camera_id);
+            bail!(
+                "camera {}: focal length must be positive (fx {fx}, fy {fy})",
+                c.camera_id
+            );
         }
         Ok(CameraModel {
             camera_id: c.camera_id,

@@ -32,10 +32,15 @@ const GRID: usize = 48;
 /// (σ1 − σ2) / (σ1 + σ2) of K_bᵀ F K_a: 0 for an essential matrix.
 pub fn essential_residual(f: &Matrix3<f64>, ka: &Matrix3<f64>, kb: &Matrix3<f64>) -> f64 {
     let e = kb.transpose() * f * ka;
-    let mut s = e.singular_values();
+    // nalgebra's default SVD iterates until convergence, which a NaN never reaches: bounded,
+    // and a matrix without singular values counts as an outlier.
+    let Some(svd) = e.try_svd(false, false, 5.0 * f64::EPSILON, 100) else {
+        return 1.0;
+    };
+    let mut s = svd.singular_values;
     s.as_mut_slice().sort_by(|x, y| y.total_cmp(x));
     match s[0] + s[1] {
-        d if d > 0.0 => (s[0] - s[1]) / d,
+        d if d > 0.0 && d.is_finite() => (s[0] - s[1]) / d,
         _ => 1.0,
     }
 }

@@ -232,8 +232,13 @@ pub fn pose_from_homography(
     opencv::calib3d::decompose_homography_mat(&mat3(h)?, &identity()?, &mut rs, &mut ts, &mut ns)?;
     let mut best: Option<RelativePose> = None;
     for k in 0..rs.len() {
-        let r = Rotation3::from_matrix(&matrix3(&rs.get(k)?)?);
         let t = vector3(&ts.get(k)?)?;
+        let Some(r) = nearest_rotation(&matrix3(&rs.get(k)?)?) else {
+            continue;
+        };
+        if !t.iter().all(|x| x.is_finite()) {
+            continue;
+        }
         let support = x1
             .iter()
             .zip(x2)
@@ -249,6 +254,30 @@ pub fn pose_from_homography(
         }
     }
     Ok(best)
+}
+
+/// The rotation nearest to `m` (U Vᵀ of its SVD, at most 100 iterations), or None when `m` is
+/// not close to a rotation (a singular value outside [0.5, 2]) or not finite. nalgebra's
+/// `Rotation3::from_matrix` spun forever on the NaN and degenerate "rotations" that
+/// `decomposeHomographyMat` returns for a NaN or rank-one H: it iterates without limit, and
+/// even `from_matrix_eps` with a limit perturbs without one.
+fn nearest_rotation(m: &Matrix3<f64>) -> Option<Rotation3<f64>> {
+    if !m.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let svd = m.try_svd(true, true, 5.0 * f64::EPSILON, 100)?;
+    if svd
+        .singular_values
+        .iter()
+        .any(|&s| !(0.5..=2.0).contains(&s))
+    {
+        return None;
+    }
+    let (mut u, v_t) = (svd.u?, svd.v_t?);
+    if (u * v_t).determinant() < 0.0 {
+        u.column_mut(2).neg_mut();
+    }
+    Some(Rotation3::from_matrix_unchecked(u * v_t))
 }
 
 /// Midpoint triangulation in camera 1's frame; None when the point is behind either camera or
@@ -302,6 +331,20 @@ const MIN_EXPLAINED: f64 = 0.5;
 
 /// The relative pose of a verified pair; see the module docs for the order of attempts.
 pub fn pair_pose(g: &StoredGeometry) -> Result<Option<RelativePose>> {
+    // Undistortion can send a keypoint far outside the image to infinity; such a point says
+    // nothing about the pose (and OpenCV's RANSAC refuses non-finite input).
+    if !g.x1.iter().chain(g.x2).flatten().all(|x| x.is_finite()) {
+        let (x1, x2): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
+            g.x1.iter()
+                .zip(g.x2)
+                .filter(|(a, b)| a.iter().chain(b.iter()).all(|x| x.is_finite()))
+                .unzip();
+        return pair_pose(&StoredGeometry {
+            x1: &x1,
+            x2: &x2,
+            ..*g
+        });
+    }
     let n = g.x1.len();
     let config = TwoViewConfig::from_code(g.config);
     let essential = match config {
@@ -560,6 +603,25 @@ pub(crate) mod tests {
                 ours.support
             );
         }
+    }
+
+    #[test]
+    fn nearest_rotation_of_degenerate_matrices_is_none_and_of_a_rotation_itself() {
+        // nalgebra's from_matrix_eps never returned on the zero matrix (its perturbation loop
+        // has no limit); a NaN, zero or rank-one matrix is no rotation.
+        for m in [
+            Matrix3::zeros(),
+            Matrix3::from_element(-1.0),
+            Matrix3::from_element(f64::NAN),
+        ] {
+            assert!(nearest_rotation(&m).is_none(), "{m}");
+        }
+        let r = Rotation3::from_euler_angles(0.3, -0.2, 1.1);
+        let back = nearest_rotation(r.matrix()).unwrap();
+        assert!(rotation_angle_deg(&(back.inverse() * r)) < 1e-9);
+        // A reflection gets the nearest proper rotation.
+        let flipped = r.matrix() * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
+        assert!((nearest_rotation(&flipped).unwrap().matrix().determinant() - 1.0).abs() < 1e-9);
     }
 
     #[test]

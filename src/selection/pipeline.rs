@@ -83,6 +83,9 @@ pub struct Plan {
     pub invalidate: Vec<u64>,
     /// Seconds per stage, for the report.
     pub timings: Timings,
+    /// The database's [`Database::data_version`] before anything was read: the write refuses a
+    /// database another program changed since.
+    pub data_version: i64,
 }
 
 impl Plan {
@@ -130,6 +133,7 @@ pub fn plan_with(
     let mut timings = Timings::default();
 
     stage("reading images and verified pairs");
+    let data_version = db.data_version()?;
     let images = db.images()?;
     let cameras = db.cameras()?;
     let pairs = db.verified_pairs()?;
@@ -194,6 +198,7 @@ pub fn plan_with(
         below_fitness_floor,
         invalidate,
         timings,
+        data_version,
     })
 }
 
@@ -241,10 +246,13 @@ fn load_scene<'a>(
         .iter()
         .zip(&camera_ids)
         .map(|(id, camera)| {
-            sizes
-                .get(camera)
-                .copied()
-                .with_context(|| format!("image {id} names camera {camera}, which does not exist"))
+            let (w, h) = sizes.get(camera).copied().with_context(|| {
+                format!("image {id} names camera {camera}, which does not exist")
+            })?;
+            if w == 0 || h == 0 {
+                bail!("camera {camera}: size {w} x {h} (width and height must be positive)");
+            }
+            Ok((w, h))
         })
         .collect::<Result<Vec<_>>>()?;
     stage("reading keypoints");
