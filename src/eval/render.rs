@@ -12,7 +12,8 @@
 //! truth is written as a COLMAP text model. Everything is deterministic from the seed.
 
 use crate::colmap::ids::SIMPLE_RADIAL;
-use crate::eval::synth::{look_at, write_gt_model, GroundTruth, GtCamera, GtImage};
+use crate::eval::synth::scene::look_at;
+use crate::eval::synth::{write_gt_model, GroundTruth, GtCamera, GtImage};
 use anyhow::{ensure, Context, Result};
 use nalgebra::{Rotation3, Vector3};
 use rand::{Rng, SeedableRng};

@@ -1,0 +1,129 @@
+//! The ground truth a synthetic scene is generated with: true poses, the shared camera, and
+//! which pairs are truly overlapping.
+
+use crate::colmap::model::ModelImage;
+use anyhow::{Context, Result};
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// True pose of one image (COLMAP convention: x_cam = rotation * X + translation).
+#[derive(Clone, Debug)]
+pub struct GtImage {
+    pub image_id: u32,
+    pub name: String,
+    /// World-to-camera rotation.
+    pub rotation: Rotation3<f64>,
+    /// World-to-camera translation.
+    pub translation: Vector3<f64>,
+    /// Camera centre in world coordinates, -R^T t.
+    pub centre: Vector3<f64>,
+}
+
+/// The shared camera.
+#[derive(Clone, Debug)]
+pub struct GtCamera {
+    pub camera_id: u32,
+    pub model_id: i32,
+    pub width: u32,
+    pub height: u32,
+    /// SIMPLE_RADIAL: f, cx, cy, k.
+    pub params: Vec<f64>,
+}
+
+/// Ground truth of one pair that has at least one correspondence.
+#[derive(Clone, Debug)]
+pub struct GtPair {
+    /// Smaller image id first, as in COLMAP's pair_id.
+    pub image_id1: u32,
+    pub image_id2: u32,
+    /// Correspondences between observations of the same 3D point.
+    pub num_true: usize,
+    /// Rows written to `matches` (true + same-appearance-other-point + random outliers).
+    pub num_matches: usize,
+    /// Inliers written to `two_view_geometries` (0 when the pair failed).
+    pub num_inliers: usize,
+    /// The verified inliers come from the same 3D points (false only in duplicate-structure
+    /// scenes, or for pairs that failed verification).
+    pub true_pair: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct GroundTruth {
+    pub camera: GtCamera,
+    /// In image_id order.
+    pub images: Vec<GtImage>,
+    /// In pair_id order.
+    pub pairs: Vec<GtPair>,
+}
+
+impl GroundTruth {
+    /// The poses as a model, for [`crate::eval::align::evaluate`].
+    pub fn model_images(&self) -> Vec<ModelImage> {
+        self.images
+            .iter()
+            .map(|im| ModelImage {
+                image_id: im.image_id,
+                camera_id: self.camera.camera_id,
+                name: im.name.clone(),
+                rotation: UnitQuaternion::from_rotation_matrix(&im.rotation),
+                translation: im.translation,
+            })
+            .collect()
+    }
+
+    /// The intrinsic matrix of the shared camera.
+    pub fn calibration(&self) -> Matrix3<f64> {
+        let p = &self.camera.params;
+        Matrix3::new(p[0], 0.0, p[1], 0.0, p[0], p[2], 0.0, 0.0, 1.0)
+    }
+}
+
+/// Writes the ground truth as a COLMAP text model (cameras.txt, images.txt with empty 2D-point
+/// lines, empty points3D.txt), e.g. for `colmap model_aligner` or `model_comparer`.
+pub fn write_gt_model(gt: &GroundTruth, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let c = &gt.camera;
+    let mut cameras = String::from(
+        "# Camera list with one line of data per camera:\n\
+         #   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n\
+         # Number of cameras: 1\n",
+    );
+    write!(
+        cameras,
+        "{} SIMPLE_RADIAL {} {}",
+        c.camera_id, c.width, c.height
+    )?;
+    for p in &c.params {
+        write!(cameras, " {p}")?;
+    }
+    cameras.push('\n');
+    let mut images = format!(
+        "# Image list with two lines of data per image:\n\
+         #   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n\
+         #   POINTS2D[] as (X, Y, POINT3D_ID)\n\
+         # Number of images: {}, mean observations per image: 0\n",
+        gt.images.len()
+    );
+    for im in &gt.images {
+        let q = UnitQuaternion::from_rotation_matrix(&im.rotation);
+        let t = im.translation;
+        writeln!(
+            images,
+            "{} {} {} {} {} {} {} {} {} {}\n",
+            im.image_id, q.w, q.i, q.j, q.k, t.x, t.y, t.z, c.camera_id, im.name
+        )?;
+    }
+    let points = "# 3D point list with one line of data per point:\n\
+                  #   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n\
+                  # Number of points: 0, mean track length: 0\n";
+    for (name, text) in [
+        ("cameras.txt", cameras.as_str()),
+        ("images.txt", images.as_str()),
+        ("points3D.txt", points),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}
