@@ -31,6 +31,14 @@ pub struct GtCamera {
     pub params: Vec<f64>,
 }
 
+impl GtCamera {
+    /// The intrinsic matrix (focal, principal point; k = 0).
+    pub fn calibration(&self) -> Matrix3<f64> {
+        let p = &self.params;
+        Matrix3::new(p[0], 0.0, p[1], 0.0, p[0], p[2], 0.0, 0.0, 1.0)
+    }
+}
+
 /// Ground truth of one pair that has at least one correspondence.
 #[derive(Clone, Debug)]
 pub struct GtPair {
@@ -74,8 +82,7 @@ impl GroundTruth {
 
     /// The intrinsic matrix of the shared camera.
     pub fn calibration(&self) -> Matrix3<f64> {
-        let p = &self.camera.params;
-        Matrix3::new(p[0], 0.0, p[1], 0.0, p[0], p[2], 0.0, 0.0, 1.0)
+        self.camera.calibration()
     }
 }
 
