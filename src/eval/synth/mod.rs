@@ -25,7 +25,7 @@
 //! between observations of equal appearance, and are true only when they come from the same 3D
 //! point. Today every point has its own appearance; a duplicate-structure scene only has to give
 //! two copies of an object the same appearance ids, and [`GtPair::true_pair`] labels the result.
-//! [`Layout::Duplicate`] is such a scene ([`crate::eval::synth::scene::duplicate`]). There, a pair's
+//! [`SyntheticScene::Duplicate`] is such a scene ([`crate::eval::synth::scene::duplicate`]). There, a pair's
 //! correspondences fall into motions (same point, or copy a's point matched to copy b's), and the
 //! verified inliers are the largest motion, as RANSAC would keep; the others stay in `matches`.
 
@@ -37,7 +37,7 @@ mod truth;
 mod write;
 
 pub use matching::pair_geometry;
-pub use spec::{Layout, SceneSpec};
+pub use spec::{SceneSpec, SyntheticScene};
 pub use truth::{write_gt_model, GroundTruth, GtCamera, GtImage, GtPair};
 
 use crate::colmap::ids::SIMPLE_RADIAL;
@@ -62,9 +62,9 @@ pub fn generate(spec: &SceneSpec, database_path: &Path) -> Result<GroundTruth> {
         );
     }
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-    let (points, images) = match spec.layout {
-        Layout::Orbit => scene::orbit::build(spec, &mut rng),
-        Layout::Duplicate {
+    let (points, images) = match spec.scene {
+        SyntheticScene::Orbit => scene::orbit::build(spec, &mut rng),
+        SyntheticScene::Duplicate {
             yaw_degrees,
             overview_images,
         } => scene::duplicate::build(spec, yaw_degrees, overview_images, &mut rng),

@@ -40,16 +40,17 @@ pub struct SceneSpec {
     /// Random uint8 descriptors (rows = keypoints) instead of empty rows; the mapper ignores them.
     pub random_descriptors: bool,
     /// Which scene.
-    pub layout: Layout,
+    pub scene: SyntheticScene,
     /// Write this focal length with `prior_focal_length = 0` and UNCALIBRATED geometries (F, no
     /// E), as COLMAP does for images without EXIF; the ground truth keeps `focal`.
     pub stored_focal: Option<f64>,
     pub seed: u64,
 }
 
-/// The scene layout.
+/// Which synthetic scene: the kinds [`crate::eval::synth::scene`] builds (not the rendered
+/// scenes of [`crate::eval::render::SceneKind`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Layout {
+pub enum SyntheticScene {
     /// Boxes on a ground disc, cameras on an orbit.
     Orbit,
     /// Two identical objects in distinct surroundings; see [`crate::eval::synth::scene::duplicate`].
@@ -82,7 +83,7 @@ impl Default for SceneSpec {
             all_pairs: true,
             relative_pose: false,
             random_descriptors: false,
-            layout: Layout::Orbit,
+            scene: SyntheticScene::Orbit,
             stored_focal: None,
             seed: 0,
         }
