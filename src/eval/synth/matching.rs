@@ -16,10 +16,6 @@ use std::collections::HashSet;
 /// 1 + 8 × copy in a + copy in b for a duplicate's copy matched to another copy.
 type Correspondence = (u32, u32, u32);
 
-fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
-    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
-}
-
 /// Relative pose cam2_from_cam1 of two images.
 fn relative_pose(a: &GtImage, b: &GtImage) -> (Rotation3<f64>, Vector3<f64>) {
     let r = b.rotation * a.rotation.inverse();
@@ -35,7 +31,7 @@ pub fn pair_geometry(
     b: &GtImage,
 ) -> (Matrix3<f64>, Matrix3<f64>, Matrix3<f64>) {
     let (r, t) = relative_pose(a, b);
-    let e = skew(&t.normalize()) * r.matrix();
+    let e = t.normalize().cross_matrix() * r.matrix();
     let k_inv = k.try_inverse().expect("calibration is invertible");
     let f = k_inv.transpose() * e * k_inv;
     let f = f / f.norm();
