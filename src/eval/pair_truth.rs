@@ -9,8 +9,8 @@
 use crate::colmap::database::Database;
 use crate::colmap::ids::image_ids;
 use crate::colmap::model;
+use crate::geometry::pose::sampson_distance;
 use anyhow::{bail, ensure, Context, Result};
-use nalgebra::{Matrix3, Vector3};
 use petgraph::unionfind::UnionFind;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
@@ -32,7 +32,7 @@ pub struct Intrinsics {
 
 impl Intrinsics {
     /// Normalised, undistorted image coordinates of pixel (x, y) (COLMAP's pixel convention).
-    fn normalise(&self, x: f64, y: f64) -> Vector3<f64> {
+    fn normalise(&self, x: f64, y: f64) -> [f64; 2] {
         let (xd, yd) = ((x - self.cx) / self.fx, (y - self.cy) / self.fy);
         let (mut xu, mut yu) = (xd, yd);
         // x_d = x_u (1 + k1 r^2 + k2 r^4): fixed-point inversion, exact for k = 0.
@@ -41,35 +41,26 @@ impl Intrinsics {
             let radial = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
             (xu, yu) = (xd / radial, yd / radial);
         }
-        Vector3::new(xu, yu, 1.0)
+        [xu, yu]
     }
 }
 
-/// Cameras of a COLMAP text model (`cameras.txt`), by camera id; models without tangential or
-/// fisheye terms only.
+/// Intrinsics of the cameras of a COLMAP text model (`cameras.txt`), by camera id; models
+/// without tangential or fisheye terms only.
 pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
-    let path = dir.join("cameras.txt");
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("reading {} (pair labels need a text model)", path.display()))?;
+    let cameras = model::read_text_cameras(dir).context("pair labels need a text model")?;
     let mut out = HashMap::new();
-    for (no, line) in text.lines().enumerate() {
-        let tok: Vec<&str> = line.split_whitespace().collect();
-        if tok.is_empty() || tok[0].starts_with('#') {
-            continue;
-        }
-        let at = || format!("{}:{}", path.display(), no + 1);
-        ensure!(
-            tok.len() >= 5,
-            "{}: expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS",
-            at()
-        );
-        let p: Vec<f64> = tok[4..]
-            .iter()
-            .map(|t| t.parse::<f64>())
-            .collect::<Result<_, _>>()
-            .with_context(at)?;
+    for c in cameras {
+        let p = &c.params;
+        let at = || {
+            format!(
+                "{}: camera {}",
+                dir.join("cameras.txt").display(),
+                c.camera_id
+            )
+        };
         let need = |n: usize| -> Result<()> {
-            ensure!(p.len() == n, "{}: {} needs {n} parameters", at(), tok[1]);
+            ensure!(p.len() == n, "{}: {} needs {n} parameters", at(), c.model);
             Ok(())
         };
         let cam = |fx, fy, cx, cy, k1, k2| Intrinsics {
@@ -80,7 +71,7 @@ pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
             k1,
             k2,
         };
-        let intrinsics = match tok[1] {
+        let intrinsics = match c.model.as_str() {
             "SIMPLE_PINHOLE" => need(3).map(|_| cam(p[0], p[0], p[1], p[2], 0.0, 0.0)),
             "PINHOLE" => need(4).map(|_| cam(p[0], p[1], p[2], p[3], 0.0, 0.0)),
             "SIMPLE_RADIAL" => need(4).map(|_| cam(p[0], p[0], p[1], p[2], p[3], 0.0)),
@@ -90,19 +81,9 @@ pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
                 at()
             ),
         }?;
-        out.insert(tok[0].parse().with_context(at)?, intrinsics);
+        out.insert(c.camera_id, intrinsics);
     }
     Ok(out)
-}
-
-/// Sampson distance in pixels of the correspondence x1 <-> x2 (normalised coordinates) under
-/// the essential matrix `e`, scaled by the focal length `focal`.
-pub fn sampson_px(e: &Matrix3<f64>, x1: &Vector3<f64>, x2: &Vector3<f64>, focal: f64) -> f64 {
-    let ex1 = e * x1;
-    let etx2 = e.transpose() * x2;
-    let num = x2.dot(&ex1);
-    let den = ex1.x.powi(2) + ex1.y.powi(2) + etx2.x.powi(2) + etx2.y.powi(2);
-    focal * num.abs() / den.sqrt().max(1e-300)
 }
 
 /// The true/false counts of one set of pairs and the connectivity of its true pairs.
@@ -134,21 +115,6 @@ pub struct PairReport {
     pub false_removed: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub true_kept: Option<usize>,
-}
-
-/// pair_id of every two_view_geometries row the mapper uses now (a pruned row has rows = 0).
-pub fn used_pairs(db: &Path, min_num_matches: usize) -> Result<HashSet<u64>> {
-    let conn =
-        rusqlite::Connection::open_with_flags(db, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY)
-            .with_context(|| format!("cannot open {}", db.display()))?;
-    let mut stmt = conn
-        .prepare("SELECT pair_id FROM two_view_geometries WHERE rows >= ?1")
-        .with_context(|| format!("{}: no two_view_geometries", db.display()))?;
-    let ids = stmt
-        .query_map([min_num_matches as i64], |r| r.get::<_, i64>(0))?
-        .map(|r| r.map(|id| id as u64))
-        .collect::<Result<_, _>>()?;
-    Ok(ids)
 }
 
 /// Median Sampson error in pixels of each of the database's verified pairs (as originally
@@ -202,7 +168,7 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
                 let p2 = keypoints[&ids[1]][b as usize];
                 let x1 = intr[0].normalise(p1[0] as f64, p1[1] as f64);
                 let x2 = intr[1].normalise(p2[0] as f64, p2[1] as f64);
-                sampson_px(&e, &x1, &x2, focal)
+                focal * sampson_distance(&e, &x1, &x2)
             })
             .collect();
         errors.sort_by(f64::total_cmp);
@@ -298,7 +264,7 @@ pub fn report(
         .filter(|im| gt_names.contains(&im.name))
         .map(|im| im.image_id)
         .collect();
-    let used = used_pairs(db_path, min_num_matches)?;
+    let used = db.used_pair_ids(min_num_matches)?;
     let counts = count(&used, &labels, &gt_images);
     let mut out = PairReport {
         threshold_px: SAMPSON_THRESHOLD_PX,
@@ -308,7 +274,7 @@ pub fn report(
         true_kept: None,
     };
     if let Some(base) = baseline {
-        let before = used_pairs(base, min_num_matches)?;
+        let before = Database::open_read_only(base)?.used_pair_ids(min_num_matches)?;
         let is = |pid: &u64, label: bool| labels.get(pid).copied().flatten() == Some(label);
         out.false_removed = Some(
             before
@@ -330,7 +296,7 @@ pub fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Rotation3;
+    use nalgebra::{Rotation3, Vector3};
 
     #[test]
     fn sampson_is_zero_for_true_correspondences_and_large_for_wrong_ones() {
@@ -341,9 +307,10 @@ mod tests {
         let x1 = point / point.z;
         let p2 = r * point + t;
         let x2 = p2 / p2.z;
-        assert!(sampson_px(&e, &x1, &x2, 400.0) < 1e-9);
-        let moved = x2 + Vector3::new(0.0, 0.05, 0.0);
-        assert!(sampson_px(&e, &x1, &moved, 400.0) > 5.0);
+        let (x1, x2) = ([x1.x, x1.y], [x2.x, x2.y]);
+        assert!(400.0 * sampson_distance(&e, &x1, &x2) < 1e-9);
+        let moved = [x2[0], x2[1] + 0.05];
+        assert!(400.0 * sampson_distance(&e, &x1, &moved) > 5.0);
     }
 
     #[test]
@@ -360,6 +327,6 @@ mod tests {
         let r2: f64 = xu * xu + yu * yu;
         let d = 1.0 + cam.k1 * r2 + cam.k2 * r2 * r2;
         let x = cam.normalise(500.0 * xu * d + 320.0, 500.0 * yu * d + 240.0);
-        assert!((x.x - xu).abs() < 1e-9 && (x.y - yu).abs() < 1e-9);
+        assert!((x[0] - xu).abs() < 1e-9 && (x[1] - yu).abs() < 1e-9);
     }
 }

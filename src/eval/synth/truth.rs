@@ -1,10 +1,10 @@
 //! The ground truth a synthetic scene is generated with: true poses, the shared camera, and
 //! which pairs are truly overlapping.
 
-use crate::colmap::model::ModelImage;
+use crate::colmap::ids::camera_model_name;
+use crate::colmap::model::{self, ModelCamera, ModelImage};
 use anyhow::{Context, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
-use std::fmt::Write as _;
 use std::path::Path;
 
 /// True pose of one image (COLMAP convention: x_cam = rotation * X + translation).
@@ -86,51 +86,18 @@ impl GroundTruth {
     }
 }
 
-/// Writes the ground truth as a COLMAP text model (cameras.txt, images.txt with empty 2D-point
-/// lines, empty points3D.txt), e.g. for `colmap model_aligner` or `model_comparer`.
+/// Writes the ground truth as a COLMAP text model (poses only), e.g. for `colmap model_aligner`
+/// or `model_comparer`.
 pub fn write_gt_model(gt: &GroundTruth, dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let c = &gt.camera;
-    let mut cameras = String::from(
-        "# Camera list with one line of data per camera:\n\
-         #   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n\
-         # Number of cameras: 1\n",
-    );
-    write!(
-        cameras,
-        "{} SIMPLE_RADIAL {} {}",
-        c.camera_id, c.width, c.height
-    )?;
-    for p in &c.params {
-        write!(cameras, " {p}")?;
-    }
-    cameras.push('\n');
-    let mut images = format!(
-        "# Image list with two lines of data per image:\n\
-         #   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n\
-         #   POINTS2D[] as (X, Y, POINT3D_ID)\n\
-         # Number of images: {}, mean observations per image: 0\n",
-        gt.images.len()
-    );
-    for im in &gt.images {
-        let q = UnitQuaternion::from_rotation_matrix(&im.rotation);
-        let t = im.translation;
-        writeln!(
-            images,
-            "{} {} {} {} {} {} {} {} {} {}\n",
-            im.image_id, q.w, q.i, q.j, q.k, t.x, t.y, t.z, c.camera_id, im.name
-        )?;
-    }
-    let points = "# 3D point list with one line of data per point:\n\
-                  #   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n\
-                  # Number of points: 0, mean track length: 0\n";
-    for (name, text) in [
-        ("cameras.txt", cameras.as_str()),
-        ("images.txt", images.as_str()),
-        ("points3D.txt", points),
-    ] {
-        let path = dir.join(name);
-        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
-    }
-    Ok(())
+    let camera = ModelCamera {
+        camera_id: c.camera_id,
+        model: camera_model_name(c.model_id)
+            .context("ground-truth camera model")?
+            .to_string(),
+        width: c.width,
+        height: c.height,
+        params: c.params.clone(),
+    };
+    model::write_text_model(dir, &[camera], &gt.model_images())
 }
