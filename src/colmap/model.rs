@@ -10,10 +10,15 @@ use std::path::{Path, PathBuf};
 /// One image of a COLMAP model (x_cam = rotation * X + translation).
 #[derive(Clone, Debug)]
 pub struct ModelImage {
+    /// IMAGE_ID of the model (not necessarily the database's).
     pub image_id: u32,
+    /// The image's camera in the model.
     pub camera_id: u32,
+    /// Image name: what models and databases are matched by.
     pub name: String,
+    /// World-to-camera rotation.
     pub rotation: UnitQuaternion<f64>,
+    /// World-to-camera translation.
     pub translation: Vector3<f64>,
 }
 
@@ -27,11 +32,15 @@ impl ModelImage {
 /// One camera of a COLMAP text model: its model's name and parameters as `cameras.txt` lists them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelCamera {
+    /// CAMERA_ID, as images.txt refers to it.
     pub camera_id: u32,
     /// COLMAP's model name, e.g. SIMPLE_RADIAL.
     pub model: String,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// The model's parameters in COLMAP's order (focal lengths, principal point, distortion).
     pub params: Vec<f64>,
 }
 

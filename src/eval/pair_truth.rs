@@ -22,11 +22,17 @@ pub const SAMPSON_THRESHOLD_PX: f64 = 4.0;
 /// Intrinsics of a ground-truth camera: pinhole plus radial distortion (k1, k2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Intrinsics {
+    /// Focal length along x (pixels).
     pub fx: f64,
+    /// Focal length along y (pixels).
     pub fy: f64,
+    /// Principal point x (pixels, COLMAP's convention).
     pub cx: f64,
+    /// Principal point y (pixels).
     pub cy: f64,
+    /// First radial distortion coefficient (0 for pinhole models).
     pub k1: f64,
+    /// Second radial distortion coefficient (RADIAL only).
     pub k2: f64,
 }
 
@@ -91,8 +97,10 @@ pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
 pub struct PairCounts {
     /// Pairs the mapper uses (at least `min_num_matches` inliers).
     pub used: usize,
+    /// Used pairs whose inliers fit the true epipolar geometry.
     #[serde(rename = "true")]
     pub true_pairs: usize,
+    /// Used pairs whose inliers do not: wrong pairs the mapper would trust.
     #[serde(rename = "false")]
     pub false_pairs: usize,
     /// Pairs with an image the ground truth lacks.
@@ -103,16 +111,22 @@ pub struct PairCounts {
     pub true_graph_largest: usize,
 }
 
+/// The `eval` report on a database's pairs against ground truth, with what a prune did to them
+/// when a baseline is given.
 #[derive(Clone, Debug, Serialize)]
 pub struct PairReport {
+    /// The Sampson threshold the labels used ([`SAMPSON_THRESHOLD_PX`]).
     pub threshold_px: f64,
+    /// Labels of the pairs the database lets the mapper use.
     #[serde(flatten)]
     pub counts: PairCounts,
     /// Set with a baseline database (the same pairs before the prune).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub baseline: Option<PairCounts>,
+    /// False pairs of the baseline the prune removed (set with a baseline).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub false_removed: Option<usize>,
+    /// True pairs of the baseline the prune kept (set with a baseline).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub true_kept: Option<usize>,
 }

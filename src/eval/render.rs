@@ -22,7 +22,9 @@ use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
 
+/// Image width of the rendered scenes (pixels), the test size.
 pub const WIDTH: u32 = 480;
+/// Image height of the rendered scenes (pixels).
 pub const HEIGHT: u32 = 360;
 /// Focal length in pixels (a 62-degree horizontal field of view).
 pub const FOCAL: f64 = 400.0;
@@ -53,6 +55,7 @@ struct Cuboid {
 #[derive(Clone, Debug)]
 pub struct Scene {
     cuboids: Vec<Cuboid>,
+    /// The cameras' true poses and the shared camera, written as the `gt` model.
     pub truth: GroundTruth,
 }
 

@@ -3,10 +3,13 @@
 /// What to generate. Every field has a default (see [`Default`]) sized for CI.
 #[derive(Clone, Debug)]
 pub struct SceneSpec {
+    /// Number of images (cameras), at least 2.
     pub num_images: usize,
     /// 3D points in the whole scene (about 60% on the boxes, the rest on the ground).
     pub num_points: usize,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Focal length in pixels.
     pub focal: f64,
@@ -44,6 +47,7 @@ pub struct SceneSpec {
     /// Write this focal length with `prior_focal_length = 0` and UNCALIBRATED geometries (F, no
     /// E), as COLMAP does for images without EXIF; the ground truth keeps `focal`.
     pub stored_focal: Option<f64>,
+    /// Seed of every random draw: same spec, same database.
     pub seed: u64,
 }
 

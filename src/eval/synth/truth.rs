@@ -10,7 +10,9 @@ use std::path::Path;
 /// True pose of one image (COLMAP convention: x_cam = rotation * X + translation).
 #[derive(Clone, Debug)]
 pub struct GtImage {
+    /// image_id in the database.
     pub image_id: u32,
+    /// Image name in the database and the ground-truth model.
     pub name: String,
     /// World-to-camera rotation.
     pub rotation: Rotation3<f64>,
@@ -23,9 +25,13 @@ pub struct GtImage {
 /// The shared camera.
 #[derive(Clone, Debug)]
 pub struct GtCamera {
+    /// camera_id in the database.
     pub camera_id: u32,
+    /// COLMAP model id (SIMPLE_RADIAL).
     pub model_id: i32,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// SIMPLE_RADIAL: f, cx, cy, k.
     pub params: Vec<f64>,
@@ -44,6 +50,7 @@ impl GtCamera {
 pub struct GtPair {
     /// Smaller image id first, as in COLMAP's pair_id.
     pub image_id1: u32,
+    /// Larger image id.
     pub image_id2: u32,
     /// Correspondences between observations of the same 3D point.
     pub num_true: usize,
@@ -56,8 +63,10 @@ pub struct GtPair {
     pub true_pair: bool,
 }
 
+/// Everything a synthetic or rendered scene was made from: camera, poses and pair labels.
 #[derive(Clone, Debug)]
 pub struct GroundTruth {
+    /// The one camera all images share.
     pub camera: GtCamera,
     /// In image_id order.
     pub images: Vec<GtImage>,
