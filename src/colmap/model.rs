@@ -325,7 +325,12 @@ mod tests {
             rotation: UnitQuaternion::from_euler_angles(0.1, -0.2, 0.3),
             translation: Vector3::new(1.0, -2.0, 0.5),
         };
-        write_text_model(dir.path(), &[camera.clone()], &[image.clone()]).unwrap();
+        write_text_model(
+            dir.path(),
+            std::slice::from_ref(&camera),
+            std::slice::from_ref(&image),
+        )
+        .unwrap();
         assert_eq!(read_text_cameras(dir.path()).unwrap(), vec![camera]);
         let back = read_images(dir.path()).unwrap();
         assert_eq!((back[0].image_id, back[0].camera_id), (7, 3));
