@@ -3,6 +3,7 @@
 
 use crate::eval::synth::GroundTruth;
 use crate::selection::pipeline::Plan;
+use petgraph::unionfind::UnionFind;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
 
@@ -111,29 +112,17 @@ pub fn measure(plan: &Plan, gt: &GroundTruth) -> Separation {
     let kept = &plan.search.selection.pairs;
     let n = plan.graph.num_vertices();
     let mut has_pair = vec![false; n];
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(parent: &mut [usize], v: usize) -> usize {
-        let mut v = v;
-        while parent[v] != v {
-            parent[v] = parent[parent[v]];
-            v = parent[v];
-        }
-        v
-    }
+    let mut components = UnionFind::<usize>::new(n);
     for (k, e) in plan.graph.edges.iter().enumerate() {
         if kept[k] {
             has_pair[e.i as usize] = true;
             has_pair[e.j as usize] = true;
             if truth[k] {
-                let (a, b) = (
-                    find(&mut parent, e.i as usize),
-                    find(&mut parent, e.j as usize),
-                );
-                parent[a] = b;
+                components.union(e.i as usize, e.j as usize);
             }
         }
     }
-    let roots: HashSet<usize> = (0..n).map(|v| find(&mut parent, v)).collect();
+    let roots: HashSet<usize> = (0..n).map(|v| components.find(v)).collect();
     Separation {
         true_pairs,
         false_pairs,
