@@ -7,7 +7,7 @@ use std::time::Instant;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::eval::separation::{measure, Separation};
-use vgsel_colmap::eval::synth::{generate, GroundTruth, Layout, SceneSpec};
+use vgsel_colmap::eval::synth::{generate, GroundTruth, SceneSpec, SyntheticScene};
 use vgsel_colmap::flow::search::{Criteria, FlowRule};
 use vgsel_colmap::selection::pipeline::{plan, Options, Plan};
 
@@ -50,7 +50,7 @@ fn duplicate(num_images: usize, num_points: usize, yaw_degrees: f64) -> SceneSpe
     SceneSpec {
         num_images,
         num_points,
-        layout: Layout::Duplicate {
+        scene: SyntheticScene::Duplicate {
             yaw_degrees,
             overview_images: 4,
         },

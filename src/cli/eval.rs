@@ -39,7 +39,8 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         None => serde_json::to_value(eval::registered(&args.model)?)?,
     };
     if let Some(db) = &args.database_path {
-        let images = Database::open_read_only(db)?.images()?.len();
+        let database = Database::open_read_only(db)?;
+        let images = database.images()?.len();
         let report = match &args.ground_truth {
             Some(gt) => Some(pair_truth::report(
                 db,
@@ -49,7 +50,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             )?),
             None => None,
         };
-        let used = pair_truth::used_pairs(db, args.min_num_matches)?.len();
+        let used = database.used_pair_ids(args.min_num_matches)?.len();
         value["images_total"] = images.into();
         value["pairs_used"] = used.into();
         value["pairs"] = serde_json::to_value(report)?;

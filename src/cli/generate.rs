@@ -113,12 +113,12 @@ fn run_database(args: &GenerateDatabaseArgs) -> Result<()> {
         num_points: args.num_points,
         view_cone_degrees: args.view_cone_degrees,
         seed: args.seed,
-        layout: match args.duplicate_yaw {
-            Some(yaw_degrees) => synth::Layout::Duplicate {
+        scene: match args.duplicate_yaw {
+            Some(yaw_degrees) => synth::SyntheticScene::Duplicate {
                 yaw_degrees,
                 overview_images: DUPLICATE_OVERVIEW_IMAGES,
             },
-            None => synth::Layout::Orbit,
+            None => synth::SyntheticScene::Orbit,
         },
         stored_focal: args.stored_focal,
         ..Default::default()

@@ -377,6 +377,23 @@ impl Database {
         Ok(xy)
     }
 
+    /// pair_id of every two_view_geometries row with at least `min_rows` inliers now (a pruned
+    /// row has rows = 0): the pairs `colmap mapper --Mapper.min_num_matches` would use.
+    pub fn used_pair_ids(&self, min_rows: usize) -> Result<HashSet<u64>> {
+        let p = &self.path;
+        let mut stmt = self
+            .conn
+            .prepare("SELECT pair_id FROM two_view_geometries WHERE rows >= ?1")
+            .sql(p)?;
+        let ids = stmt
+            .query_map([min_rows as i64], |r| r.get::<_, i64>(0))
+            .sql(p)?
+            .map(|r| r.map(|id| id as u64))
+            .collect::<Result<_, _>>()
+            .sql(p)?;
+        Ok(ids)
+    }
+
     /// Whether the project's backup table exists (even if empty).
     pub fn has_backup_table(&self) -> Result<bool> {
         table_exists(&self.conn, "vgsel_backup").sql(&self.path)

@@ -1,17 +1,24 @@
 //! Reading COLMAP sparse models (the images and their poses), text or binary, one model or a
-//! folder of sub-models as `colmap mapper` writes them (`sparse/0`, `sparse/1`, ...).
+//! folder of sub-models as `colmap mapper` writes them (`sparse/0`, `sparse/1`, ...); the
+//! cameras of text models; writing text models (ground truth for `colmap model_aligner`).
 
 use anyhow::{ensure, Context, Result};
 use nalgebra::{UnitQuaternion, Vector3};
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// One image of a COLMAP model (x_cam = rotation * X + translation).
 #[derive(Clone, Debug)]
 pub struct ModelImage {
+    /// IMAGE_ID of the model (not necessarily the database's).
     pub image_id: u32,
+    /// The image's camera in the model.
     pub camera_id: u32,
+    /// Image name: what models and databases are matched by.
     pub name: String,
+    /// World-to-camera rotation.
     pub rotation: UnitQuaternion<f64>,
+    /// World-to-camera translation.
     pub translation: Vector3<f64>,
 }
 
@@ -20,6 +27,104 @@ impl ModelImage {
     pub fn centre(&self) -> Vector3<f64> {
         -(self.rotation.inverse() * self.translation)
     }
+}
+
+/// One camera of a COLMAP text model: its model's name and parameters as `cameras.txt` lists them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelCamera {
+    /// CAMERA_ID, as images.txt refers to it.
+    pub camera_id: u32,
+    /// COLMAP's model name, e.g. SIMPLE_RADIAL.
+    pub model: String,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// The model's parameters in COLMAP's order (focal lengths, principal point, distortion).
+    pub params: Vec<f64>,
+}
+
+/// Cameras of a COLMAP text model (`DIR/cameras.txt`): `CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]`.
+pub fn read_text_cameras(dir: &Path) -> Result<Vec<ModelCamera>> {
+    let path = dir.join("cameras.txt");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let mut out = Vec::new();
+    for (no, line) in text.lines().enumerate() {
+        let tok: Vec<&str> = line.split_whitespace().collect();
+        if tok.is_empty() || tok[0].starts_with('#') {
+            continue;
+        }
+        let at = || format!("{}:{}", path.display(), no + 1);
+        ensure!(
+            tok.len() >= 5,
+            "{}: expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS",
+            at()
+        );
+        let params = tok[4..]
+            .iter()
+            .map(|t| t.parse::<f64>())
+            .collect::<Result<_, _>>()
+            .with_context(at)?;
+        out.push(ModelCamera {
+            camera_id: tok[0].parse().with_context(at)?,
+            model: tok[1].to_string(),
+            width: tok[2].parse().with_context(at)?,
+            height: tok[3].parse().with_context(at)?,
+            params,
+        });
+    }
+    Ok(out)
+}
+
+/// Writes a COLMAP text model to `dir`: cameras.txt, images.txt with empty 2D-point lines and
+/// an empty points3D.txt (poses only, as `colmap model_aligner` and `model_comparer` take).
+pub fn write_text_model(dir: &Path, cameras: &[ModelCamera], images: &[ModelImage]) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut cameras_txt = format!(
+        "# Camera list with one line of data per camera:\n\
+         #   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n\
+         # Number of cameras: {}\n",
+        cameras.len()
+    );
+    for c in cameras {
+        write!(
+            cameras_txt,
+            "{} {} {} {}",
+            c.camera_id, c.model, c.width, c.height
+        )?;
+        for p in &c.params {
+            write!(cameras_txt, " {p}")?;
+        }
+        cameras_txt.push('\n');
+    }
+    let mut images_txt = format!(
+        "# Image list with two lines of data per image:\n\
+         #   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n\
+         #   POINTS2D[] as (X, Y, POINT3D_ID)\n\
+         # Number of images: {}, mean observations per image: 0\n",
+        images.len()
+    );
+    for im in images {
+        let (q, t) = (&im.rotation, im.translation);
+        writeln!(
+            images_txt,
+            "{} {} {} {} {} {} {} {} {} {}\n",
+            im.image_id, q.w, q.i, q.j, q.k, t.x, t.y, t.z, im.camera_id, im.name
+        )?;
+    }
+    let points = "# 3D point list with one line of data per point:\n\
+                  #   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n\
+                  # Number of points: 0, mean track length: 0\n";
+    for (name, text) in [
+        ("cameras.txt", cameras_txt.as_str()),
+        ("images.txt", images_txt.as_str()),
+        ("points3D.txt", points),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
 }
 
 /// Images of a COLMAP text model (`DIR/images.txt`): each image is a pose line
@@ -201,6 +306,37 @@ mod tests {
         assert_eq!(images[1].name, "b c.jpg");
         assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
         assert!((images[1].centre() - Vector3::new(0.0, 0.0, 1.0)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn written_text_models_read_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let camera = ModelCamera {
+            camera_id: 3,
+            model: "RADIAL".into(),
+            width: 640,
+            height: 480,
+            params: vec![500.5, 320.0, 240.0, -0.1, 0.01],
+        };
+        let image = ModelImage {
+            image_id: 7,
+            camera_id: 3,
+            name: "a b.jpg".into(),
+            rotation: UnitQuaternion::from_euler_angles(0.1, -0.2, 0.3),
+            translation: Vector3::new(1.0, -2.0, 0.5),
+        };
+        write_text_model(
+            dir.path(),
+            std::slice::from_ref(&camera),
+            std::slice::from_ref(&image),
+        )
+        .unwrap();
+        assert_eq!(read_text_cameras(dir.path()).unwrap(), vec![camera]);
+        let back = read_images(dir.path()).unwrap();
+        assert_eq!((back[0].image_id, back[0].camera_id), (7, 3));
+        assert_eq!(back[0].name, image.name);
+        assert!(back[0].rotation.angle_to(&image.rotation) < 1e-12);
+        assert!((back[0].translation - image.translation).norm() < 1e-12);
     }
 
     #[test]

@@ -16,12 +16,16 @@ use std::collections::HashMap;
 /// x -> scale * rotation * x + translation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Similarity {
+    /// Scale factor (true units per model unit).
     pub scale: f64,
+    /// Rotation applied after scaling.
     pub rotation: Rotation3<f64>,
+    /// Translation applied last.
     pub translation: Vector3<f64>,
 }
 
 impl Similarity {
+    /// The similarity that changes nothing (a model already in the ground truth's frame).
     pub fn identity() -> Similarity {
         Similarity {
             scale: 1.0,
@@ -30,6 +34,7 @@ impl Similarity {
         }
     }
 
+    /// Maps a point of the model frame into the ground truth's frame.
     pub fn apply(&self, x: &Vector3<f64>) -> Vector3<f64> {
         self.scale * (self.rotation * x) + self.translation
     }
@@ -178,9 +183,11 @@ pub struct Evaluation {
 }
 
 impl Evaluation {
+    /// Largest camera-centre error over the registered images (true units).
     pub fn max_position_error(&self) -> f64 {
         self.errors.iter().map(|e| e.1).fold(0.0, f64::max)
     }
+    /// Largest rotation error over the registered images (degrees).
     pub fn max_rotation_error_deg(&self) -> f64 {
         self.errors.iter().map(|e| e.2).fold(0.0, f64::max)
     }

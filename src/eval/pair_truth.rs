@@ -9,8 +9,8 @@
 use crate::colmap::database::Database;
 use crate::colmap::ids::image_ids;
 use crate::colmap::model;
+use crate::geometry::pose::sampson_distance;
 use anyhow::{bail, ensure, Context, Result};
-use nalgebra::{Matrix3, Vector3};
 use petgraph::unionfind::UnionFind;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
@@ -22,17 +22,23 @@ pub const SAMPSON_THRESHOLD_PX: f64 = 4.0;
 /// Intrinsics of a ground-truth camera: pinhole plus radial distortion (k1, k2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Intrinsics {
+    /// Focal length along x (pixels).
     pub fx: f64,
+    /// Focal length along y (pixels).
     pub fy: f64,
+    /// Principal point x (pixels, COLMAP's convention).
     pub cx: f64,
+    /// Principal point y (pixels).
     pub cy: f64,
+    /// First radial distortion coefficient (0 for pinhole models).
     pub k1: f64,
+    /// Second radial distortion coefficient (RADIAL only).
     pub k2: f64,
 }
 
 impl Intrinsics {
     /// Normalised, undistorted image coordinates of pixel (x, y) (COLMAP's pixel convention).
-    fn normalise(&self, x: f64, y: f64) -> Vector3<f64> {
+    fn normalise(&self, x: f64, y: f64) -> [f64; 2] {
         let (xd, yd) = ((x - self.cx) / self.fx, (y - self.cy) / self.fy);
         let (mut xu, mut yu) = (xd, yd);
         // x_d = x_u (1 + k1 r^2 + k2 r^4): fixed-point inversion, exact for k = 0.
@@ -41,35 +47,26 @@ impl Intrinsics {
             let radial = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
             (xu, yu) = (xd / radial, yd / radial);
         }
-        Vector3::new(xu, yu, 1.0)
+        [xu, yu]
     }
 }
 
-/// Cameras of a COLMAP text model (`cameras.txt`), by camera id; models without tangential or
-/// fisheye terms only.
+/// Intrinsics of the cameras of a COLMAP text model (`cameras.txt`), by camera id; models
+/// without tangential or fisheye terms only.
 pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
-    let path = dir.join("cameras.txt");
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("reading {} (pair labels need a text model)", path.display()))?;
+    let cameras = model::read_text_cameras(dir).context("pair labels need a text model")?;
     let mut out = HashMap::new();
-    for (no, line) in text.lines().enumerate() {
-        let tok: Vec<&str> = line.split_whitespace().collect();
-        if tok.is_empty() || tok[0].starts_with('#') {
-            continue;
-        }
-        let at = || format!("{}:{}", path.display(), no + 1);
-        ensure!(
-            tok.len() >= 5,
-            "{}: expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS",
-            at()
-        );
-        let p: Vec<f64> = tok[4..]
-            .iter()
-            .map(|t| t.parse::<f64>())
-            .collect::<Result<_, _>>()
-            .with_context(at)?;
+    for c in cameras {
+        let p = &c.params;
+        let at = || {
+            format!(
+                "{}: camera {}",
+                dir.join("cameras.txt").display(),
+                c.camera_id
+            )
+        };
         let need = |n: usize| -> Result<()> {
-            ensure!(p.len() == n, "{}: {} needs {n} parameters", at(), tok[1]);
+            ensure!(p.len() == n, "{}: {} needs {n} parameters", at(), c.model);
             Ok(())
         };
         let cam = |fx, fy, cx, cy, k1, k2| Intrinsics {
@@ -80,7 +77,7 @@ pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
             k1,
             k2,
         };
-        let intrinsics = match tok[1] {
+        let intrinsics = match c.model.as_str() {
             "SIMPLE_PINHOLE" => need(3).map(|_| cam(p[0], p[0], p[1], p[2], 0.0, 0.0)),
             "PINHOLE" => need(4).map(|_| cam(p[0], p[1], p[2], p[3], 0.0, 0.0)),
             "SIMPLE_RADIAL" => need(4).map(|_| cam(p[0], p[0], p[1], p[2], p[3], 0.0)),
@@ -90,19 +87,9 @@ pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
                 at()
             ),
         }?;
-        out.insert(tok[0].parse().with_context(at)?, intrinsics);
+        out.insert(c.camera_id, intrinsics);
     }
     Ok(out)
-}
-
-/// Sampson distance in pixels of the correspondence x1 <-> x2 (normalised coordinates) under
-/// the essential matrix `e`, scaled by the focal length `focal`.
-pub fn sampson_px(e: &Matrix3<f64>, x1: &Vector3<f64>, x2: &Vector3<f64>, focal: f64) -> f64 {
-    let ex1 = e * x1;
-    let etx2 = e.transpose() * x2;
-    let num = x2.dot(&ex1);
-    let den = ex1.x.powi(2) + ex1.y.powi(2) + etx2.x.powi(2) + etx2.y.powi(2);
-    focal * num.abs() / den.sqrt().max(1e-300)
 }
 
 /// The true/false counts of one set of pairs and the connectivity of its true pairs.
@@ -110,8 +97,10 @@ pub fn sampson_px(e: &Matrix3<f64>, x1: &Vector3<f64>, x2: &Vector3<f64>, focal:
 pub struct PairCounts {
     /// Pairs the mapper uses (at least `min_num_matches` inliers).
     pub used: usize,
+    /// Used pairs whose inliers fit the true epipolar geometry.
     #[serde(rename = "true")]
     pub true_pairs: usize,
+    /// Used pairs whose inliers do not: wrong pairs the mapper would trust.
     #[serde(rename = "false")]
     pub false_pairs: usize,
     /// Pairs with an image the ground truth lacks.
@@ -122,32 +111,24 @@ pub struct PairCounts {
     pub true_graph_largest: usize,
 }
 
+/// The `eval` report on a database's pairs against ground truth, with what a prune did to them
+/// when a baseline is given.
 #[derive(Clone, Debug, Serialize)]
 pub struct PairReport {
+    /// The Sampson threshold the labels used ([`SAMPSON_THRESHOLD_PX`]).
     pub threshold_px: f64,
+    /// Labels of the pairs the database lets the mapper use.
     #[serde(flatten)]
     pub counts: PairCounts,
     /// Set with a baseline database (the same pairs before the prune).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub baseline: Option<PairCounts>,
+    /// False pairs of the baseline the prune removed (set with a baseline).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub false_removed: Option<usize>,
+    /// True pairs of the baseline the prune kept (set with a baseline).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub true_kept: Option<usize>,
-}
-
-/// pair_id of every two_view_geometries row the mapper uses now (a pruned row has rows = 0).
-pub fn used_pairs(db: &Path, min_num_matches: usize) -> Result<HashSet<u64>> {
-    let conn = crate::colmap::wal::open_for_reading(db, rusqlite::OpenFlags::empty())
-        .with_context(|| format!("cannot open {}", db.display()))?;
-    let mut stmt = conn
-        .prepare("SELECT pair_id FROM two_view_geometries WHERE rows >= ?1")
-        .with_context(|| format!("{}: no two_view_geometries", db.display()))?;
-    let ids = stmt
-        .query_map([min_num_matches as i64], |r| r.get::<_, i64>(0))?
-        .map(|r| r.map(|id| id as u64))
-        .collect::<Result<_, _>>()?;
-    Ok(ids)
 }
 
 /// Median Sampson error in pixels of each of the database's verified pairs (as originally
@@ -201,7 +182,7 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
                 let p2 = keypoints[&ids[1]][b as usize];
                 let x1 = intr[0].normalise(p1[0] as f64, p1[1] as f64);
                 let x2 = intr[1].normalise(p2[0] as f64, p2[1] as f64);
-                sampson_px(&e, &x1, &x2, focal)
+                focal * sampson_distance(&e, &x1, &x2)
             })
             .collect();
         errors.sort_by(f64::total_cmp);
@@ -297,7 +278,7 @@ pub fn report(
         .filter(|im| gt_names.contains(&im.name))
         .map(|im| im.image_id)
         .collect();
-    let used = used_pairs(db_path, min_num_matches)?;
+    let used = db.used_pair_ids(min_num_matches)?;
     let counts = count(&used, &labels, &gt_images);
     let mut out = PairReport {
         threshold_px: SAMPSON_THRESHOLD_PX,
@@ -307,7 +288,7 @@ pub fn report(
         true_kept: None,
     };
     if let Some(base) = baseline {
-        let before = used_pairs(base, min_num_matches)?;
+        let before = Database::open_read_only(base)?.used_pair_ids(min_num_matches)?;
         let is = |pid: &u64, label: bool| labels.get(pid).copied().flatten() == Some(label);
         out.false_removed = Some(
             before
@@ -329,7 +310,7 @@ pub fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Rotation3;
+    use nalgebra::{Rotation3, Vector3};
 
     #[test]
     fn sampson_is_zero_for_true_correspondences_and_large_for_wrong_ones() {
@@ -340,9 +321,10 @@ mod tests {
         let x1 = point / point.z;
         let p2 = r * point + t;
         let x2 = p2 / p2.z;
-        assert!(sampson_px(&e, &x1, &x2, 400.0) < 1e-9);
-        let moved = x2 + Vector3::new(0.0, 0.05, 0.0);
-        assert!(sampson_px(&e, &x1, &moved, 400.0) > 5.0);
+        let (x1, x2) = ([x1.x, x1.y], [x2.x, x2.y]);
+        assert!(400.0 * sampson_distance(&e, &x1, &x2) < 1e-9);
+        let moved = [x2[0], x2[1] + 0.05];
+        assert!(400.0 * sampson_distance(&e, &x1, &moved) > 5.0);
     }
 
     #[test]
@@ -359,6 +341,6 @@ mod tests {
         let r2: f64 = xu * xu + yu * yu;
         let d = 1.0 + cam.k1 * r2 + cam.k2 * r2 * r2;
         let x = cam.normalise(500.0 * xu * d + 320.0, 500.0 * yu * d + 240.0);
-        assert!((x.x - xu).abs() < 1e-9 && (x.y - yu).abs() < 1e-9);
+        assert!((x[0] - xu).abs() < 1e-9 && (x[1] - yu).abs() < 1e-9);
     }
 }

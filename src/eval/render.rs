@@ -12,7 +12,8 @@
 //! truth is written as a COLMAP text model. Everything is deterministic from the seed.
 
 use crate::colmap::ids::SIMPLE_RADIAL;
-use crate::eval::synth::{look_at, write_gt_model, GroundTruth, GtCamera, GtImage};
+use crate::eval::synth::scene::look_at;
+use crate::eval::synth::{write_gt_model, GroundTruth, GtCamera, GtImage};
 use anyhow::{ensure, Context, Result};
 use nalgebra::{Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -21,7 +22,9 @@ use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
 
+/// Image width of the rendered scenes (pixels), the test size.
 pub const WIDTH: u32 = 480;
+/// Image height of the rendered scenes (pixels).
 pub const HEIGHT: u32 = 360;
 /// Focal length in pixels (a 62-degree horizontal field of view).
 pub const FOCAL: f64 = 400.0;
@@ -52,6 +55,7 @@ struct Cuboid {
 #[derive(Clone, Debug)]
 pub struct Scene {
     cuboids: Vec<Cuboid>,
+    /// The cameras' true poses and the shared camera, written as the `gt` model.
     pub truth: GroundTruth,
 }
 

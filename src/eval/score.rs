@@ -15,26 +15,37 @@ pub const POSITION_TOLERANCE: f64 = 0.05;
 /// Rotation error limit in degrees.
 pub const ROTATION_TOLERANCE_DEG: f64 = 5.0;
 
+/// One ground-truth image scored against a reconstruction.
 #[derive(Clone, Debug, Serialize)]
 pub struct ImageScore {
+    /// Image name, as in both models.
     pub name: String,
     /// Index of the sub-model the image was scored in.
     pub model: usize,
     /// Centre error divided by the ground truth's extent.
     pub position_error: f64,
+    /// Angle of the rotation between estimated and true orientation (degrees).
     pub rotation_error_deg: f64,
+    /// Registered within the position and rotation tolerances.
     pub correct: bool,
 }
 
+/// A reconstruction scored against ground truth after alignment: the `eval` report.
 #[derive(Clone, Debug, Serialize)]
 pub struct Scores {
+    /// Sub-models of the reconstruction.
     pub models: usize,
+    /// Images of the ground truth.
     pub images_ground_truth: usize,
+    /// Ground-truth images the reconstruction registered.
     pub registered: usize,
+    /// Of those, the ones within tolerance ([`ImageScore::correct`]).
     pub correct: usize,
     /// Medians over registered images (relative position error, degrees); null when none.
     pub median_position_error: Option<f64>,
+    /// Median rotation error over registered images (degrees); null when none.
     pub median_rotation_error_deg: Option<f64>,
+    /// Every ground-truth image's score, registered or not.
     pub images: Vec<ImageScore>,
 }
 
@@ -93,7 +104,9 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
 /// What a model says without ground truth: its number of sub-models and of distinct images.
 #[derive(Clone, Debug, Serialize)]
 pub struct Registered {
+    /// Sub-models of the reconstruction.
     pub models: usize,
+    /// Distinct images they register.
     pub registered: usize,
 }
 

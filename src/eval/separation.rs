@@ -3,6 +3,7 @@
 
 use crate::eval::synth::GroundTruth;
 use crate::selection::pipeline::Plan;
+use petgraph::unionfind::UnionFind;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
 
@@ -35,24 +36,33 @@ pub fn auc(scores: &[f64], truth: &[bool]) -> Option<f64> {
     Some((rank_sum - positives * (positives + 1.0) / 2.0) / (positives * negatives))
 }
 
+/// How well one prior tells true pairs from false ones.
 #[derive(Clone, Debug, Serialize)]
 pub struct PriorSeparation {
+    /// The prior's name, as in the report.
     pub name: String,
     /// AUC of the prior's fitness (after g: higher is better), over the pairs it applies to.
     pub auc: Option<f64>,
     /// Share of true / false pairs the prior applies to (not NaN).
     pub coverage_true: f64,
+    /// Share of false pairs the prior applies to (not NaN).
     pub coverage_false: f64,
 }
 
+/// How well priors and a selection separate true from false pairs of a view graph.
 #[derive(Clone, Debug, Serialize)]
 pub struct Separation {
+    /// True pairs of the view graph.
     pub true_pairs: usize,
+    /// False pairs of the view graph.
     pub false_pairs: usize,
+    /// Separation by each prior alone.
     pub priors: Vec<PriorSeparation>,
     /// AUC of minus the pair cost.
     pub cost_auc: Option<f64>,
+    /// Share of the false pairs the selection removed (1 without false pairs).
     pub false_removed: f64,
+    /// Share of the true pairs the selection kept (1 without true pairs).
     pub true_kept: f64,
     /// Images (of the view graph) without any selected pair.
     pub images_without_pair: usize,
@@ -80,6 +90,7 @@ pub fn labels(plan: &Plan, gt: &GroundTruth) -> Vec<bool> {
         .collect()
 }
 
+/// Measures `plan`'s priors and selection against the synthetic ground truth `gt`.
 pub fn measure(plan: &Plan, gt: &GroundTruth) -> Separation {
     let truth = labels(plan, gt);
     let count = |f: &dyn Fn(usize) -> bool| (0..truth.len()).filter(|&k| f(k)).count();
@@ -101,29 +112,17 @@ pub fn measure(plan: &Plan, gt: &GroundTruth) -> Separation {
     let kept = &plan.search.selection.pairs;
     let n = plan.graph.num_vertices();
     let mut has_pair = vec![false; n];
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(parent: &mut [usize], v: usize) -> usize {
-        let mut v = v;
-        while parent[v] != v {
-            parent[v] = parent[parent[v]];
-            v = parent[v];
-        }
-        v
-    }
+    let mut components = UnionFind::<usize>::new(n);
     for (k, e) in plan.graph.edges.iter().enumerate() {
         if kept[k] {
             has_pair[e.i as usize] = true;
             has_pair[e.j as usize] = true;
             if truth[k] {
-                let (a, b) = (
-                    find(&mut parent, e.i as usize),
-                    find(&mut parent, e.j as usize),
-                );
-                parent[a] = b;
+                components.union(e.i as usize, e.j as usize);
             }
         }
     }
-    let roots: HashSet<usize> = (0..n).map(|v| find(&mut parent, v)).collect();
+    let roots: HashSet<usize> = (0..n).map(|v| components.find(v)).collect();
     Separation {
         true_pairs,
         false_pairs,

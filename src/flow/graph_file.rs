@@ -27,6 +27,7 @@ fn parse_int<T: std::str::FromStr>(tok: &str, line: usize, what: &str) -> Result
     }
 }
 
+/// Reads a selection problem in this format; an error names the 1-based line and what is wrong.
 pub fn parse(text: &str) -> Result<SelectionProblem> {
     // Trailing whitespace and blank lines at the end are not content.
     let body = text.trim_end_matches(|c: char| c.is_ascii_whitespace());

@@ -9,21 +9,27 @@
 /// pair arcs (lower index to higher): the caller chooses it (COLMAP image_id order in `prune`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SelectionProblem {
+    /// Cost c_i of each image arc (selecting image i).
     pub image_costs: Vec<f64>,
+    /// The pair arcs, one per view-graph edge.
     pub pairs: Vec<PairArc>,
 }
 
 /// One view-graph edge between image indices `i < j`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairArc {
+    /// Lower image index.
     pub i: u32,
+    /// Higher image index.
     pub j: u32,
+    /// Cost c_ij of the pair arc, in [-1, 0].
     pub cost: f64,
 }
 
 /// A min-cost flow for one value of F, read back as a selection.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Selection {
+    /// The flow value F this selection was solved for.
     pub flow: u64,
     /// Indexed like `SelectionProblem::image_costs`.
     pub images: Vec<bool>,

@@ -25,9 +25,12 @@ use crate::network::{Selection, SelectionProblem};
 use crate::solver::ParametricSolver;
 use serde::Serialize;
 
+/// How F is chosen: given, or the smallest F whose selection meets the criteria.
 #[derive(Clone, Copy, Debug)]
 pub enum FlowRule {
+    /// This F exactly.
     Fixed(u64),
+    /// The smallest F that meets these coverage criteria.
     Criteria(Criteria),
 }
 
@@ -50,6 +53,7 @@ impl FlowRule {
     }
 }
 
+/// Coverage a selection must reach: the smallest F that reaches it is chosen.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Criteria {
     /// Selected images / images in the view graph.
@@ -58,26 +62,38 @@ pub struct Criteria {
     pub min_pairs_per_image: f64,
 }
 
+/// One criterion after the search: its target, what the chosen F reached, whether it was met.
 #[derive(Clone, Debug, Serialize)]
 pub struct CriterionStatus {
+    /// Which criterion (images or pairs).
     pub name: String,
+    /// Count the criterion asks for.
     pub target: f64,
+    /// Count the chosen selection reaches.
     pub achieved: f64,
+    /// Whether `achieved` reaches `target`.
     pub met: bool,
     /// The criterion that was met last as F grew (the one that set F).
     pub binding: bool,
 }
 
+/// The selection's size at one F, a point of the selection curve (for plots and reports).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct CurvePoint {
+    /// The flow value F.
     pub flow: u64,
+    /// Images selected at this F.
     pub images_selected: usize,
+    /// Pairs selected at this F.
     pub pairs_selected: usize,
 }
 
+/// What the search over F found: the selection, how it met the criteria, and the curve.
 #[derive(Clone, Debug)]
 pub struct SearchResult {
+    /// The selection at the chosen F.
     pub selection: Selection,
+    /// Each criterion's status (empty for a fixed F).
     pub criteria: Vec<CriterionStatus>,
     /// True when no F met the criteria and the full graph was kept instead.
     pub capped: bool,

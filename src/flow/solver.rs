@@ -468,6 +468,7 @@ impl ParametricSolver {
         result
     }
 
+    /// The flow value F the solver has reached so far.
     pub fn flow(&self) -> u64 {
         self.flow
     }
@@ -475,9 +476,11 @@ impl ParametricSolver {
     pub fn max_flow(&self) -> u64 {
         self.max_flow
     }
+    /// Images whose image arc carries flow at the current F.
     pub fn images_selected(&self) -> usize {
         self.images_selected
     }
+    /// Pairs whose arc carries its unit at the current F.
     pub fn pairs_selected(&self) -> usize {
         self.pairs_selected
     }
@@ -493,6 +496,7 @@ impl ParametricSolver {
         self.arcs[self.pair_arc[k] as usize].cap == 0
     }
 
+    /// The current flow read back as a selection (images, pairs, cost).
     pub fn selection(&self) -> Selection {
         let images: Vec<bool> = (0..self.n).map(|i| self.image_flow(i) > 0).collect();
         let pairs: Vec<bool> = (0..self.pair_arc.len())

@@ -10,9 +10,12 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use std::collections::HashSet;
 
+/// How the images of a synthetic view graph are laid out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Arrangement {
+    /// Along a line, open at both ends (a facade, a street).
     Linear,
+    /// Around a loop, neighbours wrap around (around a building).
     Loop,
 }
 

@@ -106,10 +106,6 @@ mod tests {
     use crate::colmap::database::Camera;
     use nalgebra::{Rotation3, Vector3};
 
-    fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
-        Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
-    }
-
     #[test]
     fn recovers_the_focal_length_a_guess_got_wrong() {
         let true_f = 700.0;
@@ -130,7 +126,7 @@ mod tests {
                 let r =
                     Rotation3::from_euler_angles(0.1 * s.sin(), 0.3 * (s * 0.7).cos(), 0.05 * s);
                 let t = Vector3::new(1.0, 0.2 * s.sin(), 0.3 * s.cos());
-                let e = skew(&t) * r.matrix();
+                let e = t.cross_matrix() * r.matrix();
                 FundamentalPair {
                     a: 0,
                     b: 0,

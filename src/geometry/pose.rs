@@ -444,10 +444,6 @@ pub(crate) mod tests {
         (x1, x2)
     }
 
-    fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
-        Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
-    }
-
     fn close(p: &RelativePose, r: &Rotation3<f64>, t: &Vector3<f64>, tol_deg: f64) {
         assert!(rotation_angle_deg(&(p.rotation.inverse() * r)) < tol_deg);
         assert!(direction_angle_deg(&p.translation, t) < tol_deg);
@@ -458,7 +454,7 @@ pub(crate) mod tests {
         let r = Rotation3::from_euler_angles(0.05, -0.3, 0.1);
         let t = Vector3::new(1.0, 0.1, 0.2);
         let (x1, x2) = two_view(&r, &t, 60);
-        let e = skew(&t) * r.matrix();
+        let e = t.cross_matrix() * r.matrix();
         let k = Matrix3::new(500.0, 0.0, 320.0, 0.0, 500.0, 240.0, 0.0, 0.0, 1.0);
         let ki = k.try_inverse().unwrap();
         let f = ki.transpose() * e * ki;
@@ -488,7 +484,7 @@ pub(crate) mod tests {
         assert_eq!(p.source, PoseSource::Fundamental);
         close(&p, &r, &t, 1e-6);
         // A stored E of another pose is not trusted: the pose is estimated from the inliers.
-        let wrong = skew(&Vector3::new(0.0, 1.0, 0.0))
+        let wrong = Vector3::new(0.0, 1.0, 0.0).cross_matrix()
             * Rotation3::from_euler_angles(0.4, 0.0, 0.0).matrix();
         let p = pair_pose(&base(TwoViewConfig::Calibrated.code(), Some(wrong), None))
             .unwrap()
@@ -588,7 +584,7 @@ pub(crate) mod tests {
                     *p = [(s * 3.1).sin() * 0.5, (s * 5.3).cos() * 0.5];
                 }
             }
-            let e = skew(&t) * r.matrix();
+            let e = t.cross_matrix() * r.matrix();
             let ours = recover_pose(&e, &x1, &x2, PoseSource::Essential)
                 .unwrap()
                 .unwrap();

@@ -5,9 +5,8 @@
 //! match on the object alone: these are the false pairs that make `colmap mapper` fold the two
 //! copies into one ghosted model. The overview cameras truly link the groups.
 
-use crate::eval::synth::{
-    default_surfaces, look_at, sample_surface, GtImage, ScenePoint, SceneSpec, Surface,
-};
+use crate::eval::synth::scene::{default_surfaces, look_at, sample_surface, ScenePoint, Surface};
+use crate::eval::synth::{GtImage, SceneSpec};
 use nalgebra::{Rotation3, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
