@@ -6,6 +6,8 @@
 //! [`selection`] runs that pipeline, [`colmap::rewrite`] invalidates the unselected pairs,
 //! reversibly, and [`outputs`] describe what was done. [`eval`] is the evaluation tooling.
 
+#![warn(missing_docs)]
+
 pub mod colmap;
 pub mod costs;
 #[cfg(feature = "eval")]

@@ -18,4 +18,6 @@ if cargo tree --no-default-features -e normal --prefix none | grep -E '^(png|ran
   exit 1
 fi
 cargo clippy --workspace --all-targets --quiet -- -D warnings
+# Every public item documented (missing_docs) and every doc link resolved.
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 cargo test --workspace --all-targets

@@ -1,6 +1,8 @@
 //! The paper's selection network and its exact min-cost flow, independent of COLMAP: the network,
 //! the parametric solver, the search over F, the plain-text graph format and synthetic graphs.
 
+#![warn(missing_docs)]
+
 pub mod graph_file;
 pub mod network;
 pub mod search;

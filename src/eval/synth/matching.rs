@@ -23,7 +23,7 @@ fn relative_pose(a: &GtImage, b: &GtImage) -> (Rotation3<f64>, Vector3<f64>) {
     (r, t)
 }
 
-/// E (unit-norm t), F (unit Frobenius norm) and the infinite homography (H[2][2] = 1) of a pair,
+/// E (unit-norm t), F (unit Frobenius norm) and the infinite homography (`H[2][2] = 1`) of a pair,
 /// such that x2^T F x1 = 0 with x1 in image `a`.
 pub fn pair_geometry(
     k: &Matrix3<f64>,
