@@ -1,6 +1,6 @@
 //! Reading COLMAP databases of both layouts, and every error the reader must raise.
 
-use crate::support::Layout; // not database::Layout
+use crate::support::Schema;
 use crate::support::*;
 use rusqlite::{params, Connection};
 use std::time::Duration;
@@ -42,12 +42,12 @@ fn pair_id_round_trip() {
 
 #[test]
 fn opens_both_layouts_and_detects_them() {
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         let (_dir, path) = fixture(layout);
         let db = Database::open(&path).unwrap();
         let l = db.layout();
         assert_eq!(l.user_version, layout.user_version());
-        let latest = layout == Layout::Latest;
+        let latest = layout == Schema::Latest;
         assert_eq!(l.has_two_view_column("camera1"), latest);
         assert_eq!(l.has_two_view_column("camera2"), latest);
         assert!(l.has_two_view_column("F") && l.has_two_view_column("tvec"));
@@ -76,13 +76,13 @@ fn opens_a_database_made_by_colmap_38_if_installed() {
     assert_eq!(db.layout().two_view_columns.len(), 9);
     assert!(db.verified_pairs().unwrap().is_empty());
     // The sql/ file is the same layout.
-    let ours = empty_db(dir.path(), "ours.db", Layout::V38);
+    let ours = empty_db(dir.path(), "ours.db", Schema::V38);
     assert_eq!(schema(&path), schema(&ours));
 }
 
 #[test]
 fn reads_what_was_inserted() {
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         let (_dir, path) = fixture(layout);
         let db = Database::open_read_only(&path).unwrap();
 
@@ -170,7 +170,7 @@ fn reads_what_was_inserted() {
 
 #[test]
 fn reads_a_script_made_database_without_user_version() {
-    let (_dir, path) = fixture(Layout::V38);
+    let (_dir, path) = fixture(Schema::V38);
     exec(&path, "PRAGMA user_version = 0;");
     let db = Database::open(&path).unwrap();
     assert_eq!(db.layout().user_version, 0);
@@ -179,7 +179,7 @@ fn reads_a_script_made_database_without_user_version() {
 
 #[test]
 fn reads_large_image_ids() {
-    let (_dir, path) = fixture(Layout::Latest);
+    let (_dir, path) = fixture(Schema::Latest);
     let big = (MAX_NUM_IMAGES - 1) as u32;
     let conn = Connection::open(&path).unwrap();
     conn.execute(
@@ -258,14 +258,14 @@ fn open_errors_are_one_line_and_name_the_problem() {
     let e = err(Database::open(&empty));
     assert!(e.contains("missing tables cameras, images"), "{e}");
 
-    let (_d, newer) = fixture(Layout::Latest);
+    let (_d, newer) = fixture(Schema::Latest);
     exec(&newer, "PRAGMA user_version = 5000000;");
     let e = err(Database::open(&newer));
     assert!(e.contains("unknown schema version 5000000"), "{e}");
     exec(&newer, "PRAGMA user_version = 4990000;");
     Database::open(&newer).unwrap();
 
-    let (_d, old) = fixture(Layout::V38);
+    let (_d, old) = fixture(Schema::V38);
     exec(&old, "ALTER TABLE two_view_geometries DROP COLUMN config;");
     let e = err(Database::open(&old));
     assert!(
@@ -276,7 +276,7 @@ fn open_errors_are_one_line_and_name_the_problem() {
 
 #[test]
 fn a_locked_database_fails_with_a_clear_message() {
-    let (_dir, path) = fixture(Layout::V38);
+    let (_dir, path) = fixture(Schema::V38);
     let db = Database::open(&path).unwrap();
     db.set_busy_timeout(Duration::from_millis(100)).unwrap();
     let other = Connection::open(&path).unwrap();
@@ -290,7 +290,7 @@ fn a_locked_database_fails_with_a_clear_message() {
 }
 
 /// Opens the fixture after `sql`, runs `read`, returns its error.
-fn broken<T>(layout: Layout, sql: &str, read: impl Fn(&Database) -> anyhow::Result<T>) -> String {
+fn broken<T>(layout: Schema, sql: &str, read: impl Fn(&Database) -> anyhow::Result<T>) -> String {
     let (_dir, path) = fixture(layout);
     exec(&path, sql);
     let db = Database::open(&path).unwrap();
@@ -299,7 +299,7 @@ fn broken<T>(layout: Layout, sql: &str, read: impl Fn(&Database) -> anyhow::Resu
 
 #[test]
 fn size_check_errors() {
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         let e = broken(
             layout,
             "UPDATE keypoints SET cols = 5 WHERE image_id = 3",

@@ -47,7 +47,7 @@ const PRUNED: [(u32, u32); 3] = [(1, 2), (1, 3), (1, 4)];
 fn restore_after_migration_gives_colmap4s_form_of_the_original() {
     // Legacy: a runs table from a vgsel-colmap that did not record user_version.
     for legacy in [false, true] {
-        let (dir, db) = fixture(Layout::V38);
+        let (dir, db) = fixture(Schema::V38);
         let migrated = dir.path().join("migrated.db");
         std::fs::copy(&db, &migrated).unwrap();
         colmap4_opens(&migrated);
@@ -73,7 +73,7 @@ fn restore_after_migration_gives_colmap4s_form_of_the_original() {
 
 #[test]
 fn reprune_after_migration_keeps_colmap4s_form() {
-    let (dir, db) = fixture(Layout::V38);
+    let (dir, db) = fixture(Schema::V38);
     let migrated = dir.path().join("migrated.db");
     std::fs::copy(&db, &migrated).unwrap();
     colmap4_opens(&migrated);

@@ -2,7 +2,7 @@
 //! error line naming the problem and exit status 1 (or behaves as documented), never panics, and
 //! leaves every file in the database's directory byte for byte as it was whenever it fails.
 
-use crate::support::{dump, exec, fixture, ok, scene, snapshot, table_names, vgsel, Layout};
+use crate::support::{dump, exec, fixture, ok, scene, snapshot, table_names, vgsel, Schema};
 use rusqlite::Connection;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -81,7 +81,7 @@ fn refused_after(
 }
 
 /// The fixture (all its pairs made edges) changed by `sql` is refused with `expected`.
-fn fixture_refused(layout: Layout, sql: &str, expected: &str) {
+fn fixture_refused(layout: Schema, sql: &str, expected: &str) {
     refused_after(fixture(layout), sql, &FIXTURE_EDGES, expected);
 }
 
@@ -160,7 +160,7 @@ fn no_verified_pairs() {
 
 #[test]
 fn blob_size_disagrees_with_rows_and_cols() {
-    let (dir, db) = fixture(Layout::V38);
+    let (dir, db) = fixture(Schema::V38);
     let dir = dir.path();
     exec(
         &db,
@@ -193,7 +193,7 @@ fn blob_size_disagrees_with_rows_and_cols() {
 fn match_index_beyond_the_keypoints() {
     // Image 1 keeps 5 of its 10 keypoints (6 float32 each); pair (1, 2) has inlier 9.
     fixture_refused(
-        Layout::V38,
+        Schema::V38,
         "UPDATE keypoints SET rows = 5, data = substr(data, 1, 120) WHERE image_id = 1",
         "pair (1, 2): inlier keypoint index 9 >= 5",
     );
@@ -203,7 +203,7 @@ fn match_index_beyond_the_keypoints() {
 fn keypoints_with_unsupported_cols() {
     // 10 x 6 float32 re-labelled 20 x 3: the size still agrees, the layout does not.
     fixture_refused(
-        Layout::V38,
+        Schema::V38,
         "UPDATE keypoints SET rows = 20, cols = 3 WHERE image_id = 1",
         "keypoints of image 1: 3 columns, expected 2, 4 or 6",
     );
@@ -212,7 +212,7 @@ fn keypoints_with_unsupported_cols() {
 #[test]
 fn unknown_camera_model() {
     fixture_refused(
-        Layout::Latest,
+        Schema::Latest,
         "UPDATE cameras SET model = 99 WHERE camera_id = 2",
         "camera 2: unknown camera model 99",
     );
@@ -259,7 +259,7 @@ fn nan_and_inf_in_f_e_h_are_kept_not_used() {
 #[test]
 fn pair_ids_naming_unknown_images() {
     fixture_refused(
-        Layout::V38,
+        Schema::V38,
         "DELETE FROM images WHERE image_id = 4",
         "(images 3, 4) names image 4, which is not in the images table",
     );
@@ -452,7 +452,7 @@ fn output_that_exists() {
 
 #[test]
 fn single_image() {
-    let (dir, db) = fixture(Layout::Latest);
+    let (dir, db) = fixture(Schema::Latest);
     exec(
         &db,
         "DELETE FROM two_view_geometries; DELETE FROM matches; \

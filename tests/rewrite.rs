@@ -54,7 +54,7 @@ const B: [(u32, u32); 2] = [(1, 2), (2, 3)];
 
 #[test]
 fn apply_invalidates_exactly_the_given_pairs() {
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         let (_dir, path) = fixture(layout);
         let tvg = dump(&path, "two_view_geometries");
         let matches = dump(&path, "matches");
@@ -64,7 +64,7 @@ fn apply_invalidates_exactly_the_given_pairs() {
         let after = dump(&path, "two_view_geometries");
         assert_eq!(after.len(), tvg.len());
         let ncols = after[0].len();
-        assert_eq!(ncols, if layout == Layout::Latest { 12 } else { 10 });
+        assert_eq!(ncols, if layout == Schema::Latest { 12 } else { 10 });
         for (before, now) in tvg.iter().zip(&after) {
             let pair = vgsel_colmap::colmap::ids::image_ids(match now[0].1 {
                 Value::Integer(i) => i as u64,
@@ -84,7 +84,7 @@ fn apply_invalidates_exactly_the_given_pairs() {
         assert_eq!(backup.len(), 3);
         for pair in A {
             let mut want = row_of(&tvg, pair);
-            if layout == Layout::V38 {
+            if layout == Schema::V38 {
                 want.extend([null(), null()]);
             }
             assert_eq!(row_of(&backup, pair), want);
@@ -113,7 +113,7 @@ fn apply_invalidates_exactly_the_given_pairs() {
 
 #[test]
 fn run_record_is_written() {
-    let (_dir, path) = fixture(Layout::V38);
+    let (_dir, path) = fixture(Schema::V38);
     let db = Database::open(&path).unwrap();
     assert_eq!(last_run::<serde_json::Value>(&db).unwrap(), None);
     drop(db);
@@ -146,7 +146,7 @@ fn run_record_is_written() {
 
 #[test]
 fn apply_twice_equals_once_and_a_then_b_equals_b() {
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         let (_d1, once) = fixture(layout);
         prune(&once, &A);
         let (_d2, twice) = fixture(layout);
@@ -186,7 +186,7 @@ fn apply_twice_equals_once_and_a_then_b_equals_b() {
 #[test]
 fn restore_after_any_sequence_gives_the_original_rows() {
     let sequences: [&[&[(u32, u32)]]; 4] = [&[&A], &[&A, &B], &[&B, &A, &A], &[&[], &B]];
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         for seq in sequences {
             let (_d, path) = fixture(layout);
             let original = dump(&path, "two_view_geometries");
@@ -215,7 +215,7 @@ fn restore_after_any_sequence_gives_the_original_rows() {
 
 #[test]
 fn restore_brings_back_a_row_deleted_after_the_prune() {
-    let (_d, path) = fixture(Layout::Latest);
+    let (_d, path) = fixture(Schema::Latest);
     let original = dump(&path, "two_view_geometries");
     prune(&path, &A);
     exec(
@@ -233,7 +233,7 @@ fn restore_brings_back_a_row_deleted_after_the_prune() {
 
 #[test]
 fn restore_of_a_never_pruned_database_fails_and_changes_nothing() {
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         let (_d, path) = fixture(layout);
         let bytes = std::fs::read(&path).unwrap();
         let mut db = Database::open(&path).unwrap();
@@ -246,7 +246,7 @@ fn restore_of_a_never_pruned_database_fails_and_changes_nothing() {
 
 #[test]
 fn a_failing_apply_leaves_the_file_byte_identical() {
-    for layout in LAYOUTS {
+    for layout in SCHEMAS {
         // Never pruned: the failure must also undo creating the project's tables.
         let (_d, path) = fixture(layout);
         let bytes = std::fs::read(&path).unwrap();
@@ -276,7 +276,7 @@ fn a_failing_apply_leaves_the_file_byte_identical() {
 
 #[test]
 fn apply_on_a_locked_or_read_only_database_fails_clearly() {
-    let (_d, path) = fixture(Layout::V38);
+    let (_d, path) = fixture(Schema::V38);
     let bytes = std::fs::read(&path).unwrap();
     let mut db = Database::open(&path).unwrap();
     db.set_busy_timeout(Duration::from_millis(100)).unwrap();
@@ -296,7 +296,7 @@ fn apply_on_a_locked_or_read_only_database_fails_clearly() {
 
 #[test]
 fn copy_database_copies_and_refuses_to_clobber() {
-    let (dir, src) = fixture(Layout::Latest);
+    let (dir, src) = fixture(Schema::Latest);
     prune(&src, &A);
     let src_bytes = std::fs::read(&src).unwrap();
     let dst = dir.path().join("out.db");
@@ -345,7 +345,7 @@ fn copy_database_copies_and_refuses_to_clobber() {
     assert_eq!(std::fs::read(&src).unwrap(), src_bytes, "source modified");
 
     // The copy is a working database: restoring it gives the unpruned rows.
-    let (_d, orig) = fixture(Layout::Latest);
+    let (_d, orig) = fixture(Schema::Latest);
     let mut db = Database::open(&dst).unwrap();
     restore(&mut db).unwrap();
     drop(db);
@@ -363,7 +363,7 @@ fn large_database_is_fast_enough() {
     use rusqlite::params;
     use std::time::Instant;
     let dir = tempfile::tempdir().unwrap();
-    let path = empty_db(dir.path(), "big.db", Layout::V38);
+    let path = empty_db(dir.path(), "big.db", Schema::V38);
     let mut conn = Connection::open(&path).unwrap();
     let tx = conn.transaction().unwrap();
     tx.execute(
@@ -443,7 +443,7 @@ fn colmap_loaded_pairs(path: &Path) -> Option<usize> {
 /// the kept pairs; after restore it uses all of them again. Skipped without `colmap`.
 #[test]
 fn colmap_38_sees_only_the_kept_pairs_if_installed() {
-    let (_dir, path) = fixture(Layout::V38);
+    let (_dir, path) = fixture(Schema::V38);
     let Some(all) = colmap_loaded_pairs(&path) else {
         eprintln!("colmap not installed; skipped");
         return;

@@ -13,25 +13,26 @@ use vgsel_colmap::colmap::ids::pair_id;
 pub const COLMAP_38_SQL: &str = include_str!("../sql/colmap-3.8.sql");
 pub const COLMAP_LATEST_SQL: &str = include_str!("../sql/colmap-latest.sql");
 
+/// Which of sql/'s COLMAP layouts a fixture database is made with.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Layout {
+pub enum Schema {
     V38,
     Latest,
 }
 
-pub const LAYOUTS: [Layout; 2] = [Layout::V38, Layout::Latest];
+pub const SCHEMAS: [Schema; 2] = [Schema::V38, Schema::Latest];
 
-impl Layout {
+impl Schema {
     pub fn sql(self) -> &'static str {
         match self {
-            Layout::V38 => COLMAP_38_SQL,
-            Layout::Latest => COLMAP_LATEST_SQL,
+            Schema::V38 => COLMAP_38_SQL,
+            Schema::Latest => COLMAP_LATEST_SQL,
         }
     }
     pub fn user_version(self) -> i64 {
         match self {
-            Layout::V38 => 3800,
-            Layout::Latest => 4_010_100,
+            Schema::V38 => 3800,
+            Schema::Latest => 4_010_100,
         }
     }
 }
@@ -40,7 +41,7 @@ pub use vgsel_colmap::colmap::blob::{
     encode_f32 as f32_blob, encode_f64 as f64_blob, encode_pairs as pairs_blob,
 };
 
-pub fn empty_db(dir: &Path, name: &str, layout: Layout) -> PathBuf {
+pub fn empty_db(dir: &Path, name: &str, layout: Schema) -> PathBuf {
     let path = dir.join(name);
     let conn = Connection::open(&path).unwrap();
     conn.execute_batch(layout.sql()).unwrap();
@@ -99,13 +100,13 @@ pub fn f_of(pair: (u32, u32)) -> [f64; 9] {
 /// A fixture with cameras, 4 images, keypoints (cols 6, 4 and 2), raw matches, 4 verified pairs
 /// and 2 failed pairs: (2,4) with data NULL, and (1,4) with zero-length blobs and odd storage
 /// classes (TEXT qvec, REAL tvec) that a restore must keep.
-pub fn fixture(layout: Layout) -> (TempDir, PathBuf) {
+pub fn fixture(layout: Schema) -> (TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let path = empty_db(dir.path(), "database.db", layout);
     let conn = Connection::open(&path).unwrap();
     // One transaction: one fsync instead of one per row.
     conn.execute_batch("BEGIN").unwrap();
-    let latest = layout == Layout::Latest;
+    let latest = layout == Schema::Latest;
     conn.execute(
         "INSERT INTO cameras (camera_id, model, width, height, params, prior_focal_length) VALUES (1, 2, 640, 480, ?1, 0), (2, 1, 800, 600, ?2, 1)",
         params![f64_blob(&[500.0, 320.0, 240.0, 0.01]), f64_blob(&[400.0, 410.0, 300.0, 200.0])],
