@@ -69,6 +69,9 @@ enum Command {
     /// Score a reconstruction against ground-truth poses; prints JSON.
     #[cfg(feature = "eval")]
     Eval(cli::eval::EvalArgs),
+    /// AUC of every prior (true pairs over false) from `prune --scores` and `eval --labels`.
+    #[cfg(feature = "eval")]
+    Separation(cli::separation::SeparationArgs),
     /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
     #[cfg(feature = "eval")]
     #[command(subcommand)]
@@ -120,6 +123,8 @@ fn main() -> ExitCode {
         Command::Solve(args) => cli::solve::run(&args),
         #[cfg(feature = "eval")]
         Command::Eval(args) => cli::eval::run(&args),
+        #[cfg(feature = "eval")]
+        Command::Separation(args) => cli::separation::run(&args),
         #[cfg(feature = "eval")]
         Command::Generate(command) => cli::generate::run(&command),
         Command::Export(args) => cli::export::run(&args, quiet, &progress),

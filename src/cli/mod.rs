@@ -15,6 +15,8 @@ pub mod inspect;
 pub mod progress;
 pub mod prune;
 pub mod restore;
+#[cfg(feature = "eval")]
+pub mod separation;
 pub mod solve;
 
 use anyhow::{Context, Result};

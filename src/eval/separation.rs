@@ -3,9 +3,11 @@
 
 use crate::eval::synth::GroundTruth;
 use crate::selection::pipeline::Plan;
+use anyhow::{bail, Context, Result};
 use petgraph::unionfind::UnionFind;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
+use std::fmt::Write as _;
 
 /// Probability that a random true pair scores above a random false pair (ties count half);
 /// NaN scores are left out. None without both classes.
@@ -165,9 +167,107 @@ impl Separation {
     }
 }
 
+/// The AUC table of a `prune --scores` CSV against an `eval --labels` CSV (pairs joined by their
+/// image ids): per column, the AUC of true pairs over false ones (of -cost for `cost`, where lower
+/// is better) and how many pairs have a value; then how many true and false pairs were kept.
+pub fn csv_table(scores: &str, labels: &str) -> Result<String> {
+    let rows = |text: &str, what: &str| -> Result<(Vec<String>, Vec<Vec<String>>)> {
+        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+        let header: Vec<String> = lines
+            .next()
+            .with_context(|| format!("{what} is empty"))?
+            .split(',')
+            .map(str::to_string)
+            .collect();
+        let body = lines
+            .map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>())
+            .collect::<Vec<_>>();
+        if let Some(bad) = body.iter().position(|r| r.len() != header.len()) {
+            bail!(
+                "{what} line {}: {} fields, the header has {}",
+                bad + 2,
+                body[bad].len(),
+                header.len()
+            );
+        }
+        Ok((header, body))
+    };
+    let (score_header, score_rows) = rows(scores, "the scores CSV")?;
+    let (label_header, label_rows) = rows(labels, "the labels CSV")?;
+    let column = |header: &[String], name: &str, what: &str| -> Result<usize> {
+        header
+            .iter()
+            .position(|h| h == name)
+            .with_context(|| format!("{what} has no column `{name}`"))
+    };
+    let key = |header: &[String], what: &str| -> Result<[usize; 2]> {
+        Ok([
+            column(header, "image_id1", what)?,
+            column(header, "image_id2", what)?,
+        ])
+    };
+    let [a, b] = key(&label_header, "the labels CSV")?;
+    let truth_column = column(&label_header, "true_pair", "the labels CSV")?;
+    let truth: HashMap<(String, String), bool> = label_rows
+        .iter()
+        .map(|r| ((r[a].clone(), r[b].clone()), r[truth_column] == "1"))
+        .collect();
+    let [sa, sb] = key(&score_header, "the scores CSV")?;
+    let kept_column = column(&score_header, "kept", "the scores CSV")?;
+    let labelled: Vec<(&Vec<String>, bool)> = score_rows
+        .iter()
+        .filter_map(|r| truth.get(&(r[sa].clone(), r[sb].clone())).map(|&t| (r, t)))
+        .collect();
+    let n_true = labelled.iter().filter(|(_, t)| *t).count();
+    let mut out = format!(
+        "{} labelled pairs: {n_true} true, {} false\n{:<28} {:>6} {:>18}\n",
+        labelled.len(),
+        labelled.len() - n_true,
+        "column",
+        "AUC",
+        "pairs with a value"
+    );
+    for (c, name) in score_header.iter().enumerate() {
+        if c == sa || c == sb || c == kept_column {
+            continue;
+        }
+        let sign = if name == "cost" { -1.0 } else { 1.0 };
+        let (values, classes): (Vec<f64>, Vec<bool>) = labelled
+            .iter()
+            .filter(|(r, _)| !r[c].is_empty())
+            .map(|(r, t)| {
+                Ok((
+                    sign * r[c]
+                        .parse::<f64>()
+                        .with_context(|| format!("column {name}: `{}` is no number", r[c]))?,
+                    *t,
+                ))
+            })
+            .collect::<Result<Vec<_>>>()?
+            .into_iter()
+            .unzip();
+        let auc = auc(&values, &classes).unwrap_or(f64::NAN);
+        writeln!(out, "{name:<28} {auc:>6.3} {:>18}", values.len())?;
+    }
+    let kept = |want: bool| {
+        labelled
+            .iter()
+            .filter(|(r, t)| *t == want && r[kept_column] == "1")
+            .count()
+    };
+    writeln!(
+        out,
+        "kept: {}/{n_true} true, {}/{} false",
+        kept(true),
+        kept(false),
+        labelled.len() - n_true
+    )?;
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::auc;
+    use super::{auc, csv_table};
 
     #[test]
     fn auc_of_perfect_reversed_tied_and_absent() {
@@ -177,5 +277,27 @@ mod tests {
         assert_eq!(auc(&[0.5; 4], &t), Some(0.5));
         assert_eq!(auc(&[0.9, f64::NAN, 0.1, f64::NAN], &t), Some(1.0));
         assert_eq!(auc(&[0.9, 0.8], &[true, true]), None);
+    }
+
+    #[test]
+    fn csv_table_joins_by_image_ids_and_ranks_cost_lower_is_better() {
+        let scores = "image_id1,image_id2,inliers,cost,kept\n\
+                      1,2,30,-0.9,1\n1,3,10,-0.2,0\n2,3,20,-0.5,1\n3,4,5,-0.1,0\n";
+        // (3, 4) has no label and is left out; (1, 3) is the one false pair.
+        let labels = "image_id1,image_id2,median_sampson_px,true_pair\n\
+                      1,2,0.5,1\n1,3,9.0,0\n2,3,1.0,1\n";
+        let table = csv_table(scores, labels).unwrap();
+        let lines: Vec<&str> = table.lines().collect();
+        assert_eq!(lines[0], "3 labelled pairs: 2 true, 1 false");
+        assert!(
+            lines[2].starts_with("inliers") && lines[2].contains(" 1.000 "),
+            "{table}"
+        );
+        assert!(
+            lines[3].starts_with("cost") && lines[3].contains(" 1.000 "),
+            "{table}"
+        );
+        assert_eq!(lines[4], "kept: 2/2 true, 0/1 false");
+        assert!(csv_table("a,b\n1\n", labels).is_err());
     }
 }
