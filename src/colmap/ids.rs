@@ -96,6 +96,14 @@ pub fn camera_model_num_params(model_id: i32) -> Option<usize> {
     camera_model(model_id).map(|m| m.1)
 }
 
+/// The `model_id` of COLMAP's camera model `name` (as model files write it).
+pub fn camera_model_id(name: &str) -> Option<i32> {
+    CAMERA_MODELS
+        .iter()
+        .position(|m| m.0 == name)
+        .map(|k| k as i32)
+}
+
 /// COLMAP's name of camera model `model_id`, for messages and model files.
 pub fn camera_model_name(model_id: i32) -> Option<&'static str> {
     camera_model(model_id).map(|m| m.0)
@@ -117,6 +125,8 @@ mod tests {
         assert_eq!(camera_model_name(SIMPLE_RADIAL), Some("SIMPLE_RADIAL"));
         assert_eq!(camera_model_num_params(10), Some(12));
         assert_eq!(camera_model_name(11), None);
+        assert_eq!(camera_model_id("RADIAL"), Some(3));
+        assert_eq!(camera_model_id("NOPE"), None);
     }
 
     #[test]

@@ -6,11 +6,13 @@
 //! Why: the mapper's model only shows the end result; counting the false pairs a prune removed
 //! and the true pairs it kept says whether the selection itself did the right thing.
 
-use crate::colmap::database::Database;
+use crate::colmap::database::{Camera, Database};
 use crate::colmap::ids::image_ids;
+use crate::colmap::ids::{camera_model_id, camera_model_num_params};
 use crate::colmap::model;
+use crate::geometry::camera::CameraModel;
 use crate::geometry::pose::sampson_distance;
-use anyhow::{bail, ensure, Context, Result};
+use anyhow::{ensure, Context, Result};
 use petgraph::unionfind::UnionFind;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
@@ -19,75 +21,35 @@ use std::path::Path;
 /// A pair is true when the median Sampson distance of its inliers is below this many pixels.
 pub const SAMPSON_THRESHOLD_PX: f64 = 4.0;
 
-/// Intrinsics of a ground-truth camera: pinhole plus radial distortion (k1, k2).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Intrinsics {
-    /// Focal length along x (pixels).
-    pub fx: f64,
-    /// Focal length along y (pixels).
-    pub fy: f64,
-    /// Principal point x (pixels, COLMAP's convention).
-    pub cx: f64,
-    /// Principal point y (pixels).
-    pub cy: f64,
-    /// First radial distortion coefficient (0 for pinhole models).
-    pub k1: f64,
-    /// Second radial distortion coefficient (RADIAL only).
-    pub k2: f64,
-}
-
-impl Intrinsics {
-    /// Normalised, undistorted image coordinates of pixel (x, y) (COLMAP's pixel convention).
-    fn normalise(&self, x: f64, y: f64) -> [f64; 2] {
-        let (xd, yd) = ((x - self.cx) / self.fx, (y - self.cy) / self.fy);
-        let (mut xu, mut yu) = (xd, yd);
-        // x_d = x_u (1 + k1 r^2 + k2 r^4): fixed-point inversion, exact for k = 0.
-        for _ in 0..20 {
-            let r2 = xu * xu + yu * yu;
-            let radial = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
-            (xu, yu) = (xd / radial, yd / radial);
-        }
-        [xu, yu]
-    }
-}
-
-/// Intrinsics of the cameras of a COLMAP text model (`cameras.txt`), by camera id; models
-/// without tangential or fisheye terms only.
-pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, Intrinsics>> {
+/// The cameras of a COLMAP text model (`cameras.txt`) as the geometry's camera models, by camera
+/// id: the same undistortion the priors use.
+pub fn read_cameras(dir: &Path) -> Result<HashMap<u32, CameraModel>> {
     let cameras = model::read_text_cameras(dir).context("pair labels need a text model")?;
     let mut out = HashMap::new();
     for c in cameras {
-        let p = &c.params;
-        let at = || {
-            format!(
-                "{}: camera {}",
-                dir.join("cameras.txt").display(),
-                c.camera_id
-            )
+        let at = format!(
+            "{}: camera {}",
+            dir.join("cameras.txt").display(),
+            c.camera_id
+        );
+        let model_id = camera_model_id(&c.model)
+            .with_context(|| format!("{at}: unknown camera model {}", c.model))?;
+        let n = camera_model_num_params(model_id).unwrap_or(0);
+        ensure!(
+            c.params.len() == n,
+            "{at}: {} needs {n} parameters",
+            c.model
+        );
+        let camera = Camera {
+            camera_id: c.camera_id,
+            model_id,
+            width: c.width,
+            height: c.height,
+            params: c.params,
+            prior_focal_length: true,
         };
-        let need = |n: usize| -> Result<()> {
-            ensure!(p.len() == n, "{}: {} needs {n} parameters", at(), c.model);
-            Ok(())
-        };
-        let cam = |fx, fy, cx, cy, k1, k2| Intrinsics {
-            fx,
-            fy,
-            cx,
-            cy,
-            k1,
-            k2,
-        };
-        let intrinsics = match c.model.as_str() {
-            "SIMPLE_PINHOLE" => need(3).map(|_| cam(p[0], p[0], p[1], p[2], 0.0, 0.0)),
-            "PINHOLE" => need(4).map(|_| cam(p[0], p[1], p[2], p[3], 0.0, 0.0)),
-            "SIMPLE_RADIAL" => need(4).map(|_| cam(p[0], p[0], p[1], p[2], p[3], 0.0)),
-            "RADIAL" => need(5).map(|_| cam(p[0], p[0], p[1], p[2], p[3], p[4])),
-            other => bail!(
-                "{}: camera model {other} is not supported for pair labels",
-                at()
-            ),
-        }?;
-        out.insert(c.camera_id, intrinsics);
+        let model = CameraModel::from_colmap(&camera).with_context(|| at.clone())?;
+        out.insert(camera.camera_id, model);
     }
     Ok(out)
 }
@@ -156,17 +118,14 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
             continue;
         };
         let mut intr = Vec::new();
-        for pose in &poses {
-            intr.push(
-                cameras.get(&pose.camera_id).with_context(|| {
-                    format!("{}: image {} has no camera", gt.display(), pose.name)
-                })?,
-            );
-        }
-        for id in ids {
+        for (pose, id) in poses.iter().zip(ids) {
+            let camera = cameras
+                .get(&pose.camera_id)
+                .with_context(|| format!("{}: image {} has no camera", gt.display(), pose.name))?;
             if let std::collections::hash_map::Entry::Vacant(v) = keypoints.entry(id) {
-                v.insert(db.keypoints_xy(id)?);
+                v.insert(camera.normalise(&db.keypoints_xy(id)?)?);
             }
+            intr.push(camera);
         }
         let r1 = poses[0].rotation.to_rotation_matrix();
         let r2 = poses[1].rotation.to_rotation_matrix();
@@ -178,10 +137,8 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
             .inliers
             .iter()
             .map(|&[a, b]| {
-                let p1 = keypoints[&ids[0]][a as usize];
-                let p2 = keypoints[&ids[1]][b as usize];
-                let x1 = intr[0].normalise(p1[0] as f64, p1[1] as f64);
-                let x2 = intr[1].normalise(p2[0] as f64, p2[1] as f64);
+                let x1 = keypoints[&ids[0]][a as usize];
+                let x2 = keypoints[&ids[1]][b as usize];
                 focal * sampson_distance(&e, &x1, &x2)
             })
             .collect();
@@ -328,19 +285,28 @@ mod tests {
     }
 
     #[test]
-    fn radial_undistortion_inverts_the_distortion() {
-        let cam = Intrinsics {
-            fx: 500.0,
-            fy: 500.0,
-            cx: 320.0,
-            cy: 240.0,
-            k1: -0.1,
-            k2: 0.02,
-        };
+    fn ground_truth_cameras_undistort_as_the_priors_do() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("cameras.txt"),
+            "# one camera\n3 RADIAL 640 480 500 320 240 -0.1 0.02\n",
+        )
+        .unwrap();
+        let cameras = read_cameras(dir.path()).unwrap();
         let (xu, yu) = (0.4, -0.3);
         let r2: f64 = xu * xu + yu * yu;
-        let d = 1.0 + cam.k1 * r2 + cam.k2 * r2 * r2;
-        let x = cam.normalise(500.0 * xu * d + 320.0, 500.0 * yu * d + 240.0);
-        assert!((x[0] - xu).abs() < 1e-9 && (x[1] - yu).abs() < 1e-9);
+        let d = 1.0 - 0.1 * r2 + 0.02 * r2 * r2;
+        let pixel = [
+            (500.0 * xu * d + 320.0) as f32,
+            (500.0 * yu * d + 240.0) as f32,
+        ];
+        let x = cameras[&3].normalise(&[pixel]).unwrap()[0];
+        // Within 0.05 px at f = 500 (OpenCV's iterative inversion, float32 keypoints).
+        assert!(
+            (x[0] - xu).abs() < 1e-4 && (x[1] - yu).abs() < 1e-4,
+            "{x:?}"
+        );
+        std::fs::write(dir.path().join("cameras.txt"), "3 RADIAL 640 480 500 320\n").unwrap();
+        assert!(read_cameras(dir.path()).is_err());
     }
 }
