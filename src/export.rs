@@ -81,6 +81,7 @@ pub fn export(db: &Database, format: Format) -> Result<(String, Exported)> {
         rule: FlowRule::Fixed(0),
         model: CostModel::general(),
         unweighted_priors: true,
+        capture: Default::default(),
     };
     let plan = prune::plan_with(db, &options, &Overrides::default(), &|_| {})?;
     let removed = removed_pair_ids(db)?;

@@ -8,6 +8,7 @@
 
 pub mod align;
 pub mod camera;
+pub mod capture_order;
 pub mod costs;
 pub mod database;
 pub mod duplicate_scene;

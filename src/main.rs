@@ -56,7 +56,7 @@ enum Command {
   vgsel-colmap prune --database_path db.db --dry_run -v --min_pairs_per_image 10
   vgsel-colmap prune --database_path db.db --output pruned.db --pairs_out pairs.txt \\
       --keep_pairs keep.txt --forbid_images bad_images.txt")]
-    Prune(cli::prune::PruneArgs),
+    Prune(Box<cli::prune::PruneArgs>),
     /// Put back every pair a prune invalidated, byte for byte, and drop vgsel-colmap's tables.
     Restore(cli::args::DatabaseArg),
     /// Print the view graph's figures.

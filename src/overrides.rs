@@ -208,7 +208,7 @@ impl Overrides {
 #[derive(Clone, Debug)]
 pub struct Network {
     pub problem: SelectionProblem,
-    /// View-graph vertex of each network image (ascending, so pair arcs keep their orientation).
+    /// View-graph vertex of each network image, in the order that orients the pair arcs.
     vertex_of: Vec<u32>,
     /// View-graph edge of each network pair.
     edge_of: Vec<usize>,
@@ -217,24 +217,27 @@ pub struct Network {
 }
 
 impl Network {
-    pub fn new(graph: &ViewGraph, costs: &Costs, resolved: &Resolved) -> Network {
+    /// `rank` is each view-graph vertex's position in the order the pair arcs follow (lower to
+    /// higher; [`crate::capture_order`]).
+    pub fn new(graph: &ViewGraph, costs: &Costs, resolved: &Resolved, rank: &[u32]) -> Network {
         let mut index = vec![u32::MAX; graph.num_vertices()];
-        let mut vertex_of = Vec::new();
+        let mut vertex_of: Vec<u32> = (0..graph.num_vertices() as u32)
+            .filter(|&v| !resolved.forbidden_vertices[v as usize])
+            .collect();
+        vertex_of.sort_by_key(|&v| rank[v as usize]);
         let mut image_costs = Vec::new();
-        for (v, &forbidden) in resolved.forbidden_vertices.iter().enumerate() {
-            if !forbidden {
-                index[v] = vertex_of.len() as u32;
-                vertex_of.push(v as u32);
-                image_costs.push(costs.image_costs[v]);
-            }
+        for (k, &v) in vertex_of.iter().enumerate() {
+            index[v as usize] = k as u32;
+            image_costs.push(costs.image_costs[v as usize]);
         }
         let mut pairs = Vec::new();
         let mut edge_of = Vec::new();
         for (k, e) in graph.edges.iter().enumerate() {
             if resolved.edges[k] == EdgeRule::Free {
+                let (a, b) = (index[e.i as usize], index[e.j as usize]);
                 pairs.push(PairArc {
-                    i: index[e.i as usize],
-                    j: index[e.j as usize],
+                    i: a.min(b),
+                    j: a.max(b),
                     cost: costs.pair_costs[k],
                 });
                 edge_of.push(k);

@@ -1,6 +1,7 @@
 //! The prune pipeline up to the selection: read the database, build the view graph, compute the
 //! priors and costs, run the flow search. It writes nothing; [`crate::rewrite`] applies the plan.
 
+use crate::capture_order::{self, CaptureOrder};
 use crate::costs::{self, CostModel, Costs};
 use crate::database::{pair_id, Database, Image, VerifiedPair};
 use crate::overrides::{EdgeRule, Listed, Network, Overrides};
@@ -21,6 +22,8 @@ pub struct Options {
     /// `--scores`. Otherwise they are skipped, which matters at scale (multiple motions run a
     /// RANSAC per pair).
     pub unweighted_priors: bool,
+    /// The order the network's pair arcs follow.
+    pub capture: capture_order::Input,
 }
 
 /// Seconds spent in each stage.
@@ -47,6 +50,8 @@ pub struct Plan {
     /// The network the flow ran on (the view graph less the overrides' arcs).
     pub network: Network,
     pub overrides: Listed,
+    /// The order the pair arcs followed.
+    pub order: CaptureOrder,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
     /// The fitness floor applied ([`fitness_floor`]) and the edges it left out of the network.
@@ -104,6 +109,7 @@ pub fn plan_with(
         );
     }
     let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
+    let order = capture_order::compute(&options.capture, &graph, &images, &pairs)?;
     let camera_of: HashMap<u32, u32> = images
         .iter()
         .map(|im| (im.image_id, im.camera_id))
@@ -152,7 +158,7 @@ pub fn plan_with(
             below_fitness_floor += 1;
         }
     }
-    let network = Network::new(&graph, &costs, &resolved);
+    let network = Network::new(&graph, &costs, &resolved, &order.rank);
     let mut search = search::search(&network.problem, &options.rule);
     search.selection = network.expand(&graph, &search.selection);
     timings.solve = t.elapsed().as_secs_f64();
@@ -175,6 +181,7 @@ pub fn plan_with(
         costs,
         network,
         overrides: resolved.listed,
+        order,
         search,
         fitness_floor: floor,
         below_fitness_floor,
@@ -253,6 +260,7 @@ mod tests {
             },
             model: CostModel::disambiguation(),
             unweighted_priors: false,
+            capture: Default::default(),
         };
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already, and
         // half of 0.4 pairs per image x 5 images is one pair.

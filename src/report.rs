@@ -44,6 +44,7 @@ pub struct Report {
     pub criteria: Vec<CriterionStatus>,
     pub priors: Vec<PriorSummary>,
     pub overrides: Listed,
+    pub order: OrderReport,
     /// Files written besides the database: filled in by the command as it writes them.
     pub outputs: Outputs,
     pub timings: Timings,
@@ -54,6 +55,19 @@ pub struct Report {
 pub struct Outputs {
     pub pairs_out: Option<String>,
     pub plots: Vec<String>,
+}
+
+/// The order the pair arcs followed and how sequential the pairs are in it.
+#[derive(Debug, Serialize)]
+pub struct OrderReport {
+    pub name: crate::capture_order::Order,
+    /// Share of the selected pairs whose images are at most `window` positions apart (null when
+    /// none is selected), and the same over the whole view graph for comparison.
+    pub selected_within_window: Option<f64>,
+    pub view_graph_within_window: Option<f64>,
+    pub window: u32,
+    /// With the `exif` order: images without a capture time (placed last, by name).
+    pub images_without_time: usize,
 }
 
 /// Spread of one prior's fitness over all images or pairs, and over the selected ones.
@@ -115,6 +129,17 @@ impl Report {
             &selection.pairs,
             "pairs",
         ));
+        let order = &plan.order;
+        let window = crate::capture_order::SEQUENTIAL_WINDOW;
+        let share = |kept: Option<&[bool]>| {
+            let edges = plan.graph.edges.iter().enumerate();
+            order.share_within(
+                edges
+                    .filter(|(k, _)| kept.is_none_or(|kept| kept[*k]))
+                    .map(|(_, e)| (e.i, e.j)),
+                window,
+            )
+        };
         Report {
             schema_version: SCHEMA_VERSION,
             tool_version: env!("CARGO_PKG_VERSION"),
@@ -139,6 +164,13 @@ impl Report {
             criteria: plan.search.criteria.clone(),
             priors,
             overrides: plan.overrides.clone(),
+            order: OrderReport {
+                name: order.order,
+                selected_within_window: share(Some(&selection.pairs)),
+                view_graph_within_window: share(None),
+                window,
+                images_without_time: order.images_without_time,
+            },
             outputs: Outputs::default(),
             timings: plan.timings.clone(),
         }
@@ -183,6 +215,17 @@ impl Report {
                 ""
             }
         );
+        if let Some(share) = self.order.selected_within_window {
+            s += &format!(
+                "\npair arcs in {} order: {:.0}% of the selected pairs are within {} positions",
+                serde_json::to_value(self.order.name)
+                    .unwrap_or_default()
+                    .as_str()
+                    .unwrap_or(""),
+                100.0 * share,
+                self.order.window
+            );
+        }
         let o = &self.overrides;
         if !(o.keep_pairs.is_empty() && o.forbid_pairs.is_empty() && o.forbid_images.is_empty()) {
             s += &format!(

@@ -25,6 +25,7 @@ fn guessed_focal_length_is_replaced_by_the_estimate() {
         rule: FlowRule::Fixed(4),
         model: CostModel::general(),
         unweighted_priors: false,
+        capture: Default::default(),
     };
     let p = plan(&db, &options, &|_| {}).unwrap();
     assert_eq!(p.focal_estimates.len(), 1);

@@ -37,6 +37,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         }),
         model: all_priors(),
         unweighted_priors: true,
+        capture: Default::default(),
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();
     eprintln!("plan: {:?}", p.timings);

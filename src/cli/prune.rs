@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use vgsel_colmap::capture_order::{self, Order};
 use vgsel_colmap::database::Database;
 use vgsel_colmap::overrides::{NameList, Overrides};
 use vgsel_colmap::progress::Progress;
@@ -69,6 +70,14 @@ pub struct PruneArgs {
     /// Never select these images nor any of their pairs (one name a line).
     #[arg(long, value_name = "FILE")]
     forbid_images: Option<PathBuf>,
+    /// The order the network's pair arcs follow (lower to higher): the paper's flow chains
+    /// images along it, so name the capture order when the photos are a sequence (see
+    /// docs/cli.md).
+    #[arg(long, value_enum, default_value = "image_id")]
+    order: Order,
+    /// The image folder, read for --order exif.
+    #[arg(long, value_name = "DIR")]
+    image_path: Option<PathBuf>,
 }
 
 impl PruneArgs {
@@ -127,6 +136,10 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         rule: args.flow.rule(args.preset.criteria()),
         model,
         unweighted_priors: args.scores.is_some(),
+        capture: capture_order::Input {
+            order: args.order,
+            image_path: args.image_path.clone(),
+        },
     };
     let stage = |s: &str| progress.stage(s);
     let overrides = args.overrides()?;
@@ -154,6 +167,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         "keep_pairs": path_text(&args.keep_pairs),
         "forbid_pairs": path_text(&args.forbid_pairs),
         "forbid_images": path_text(&args.forbid_images),
+        "order": args.order,
     });
     // The extra files first: if one cannot be written, the database is still untouched.
     let mut outputs = Outputs::default();
