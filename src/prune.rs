@@ -256,6 +256,7 @@ mod tests {
                 None => FlowRule::Criteria(Criteria {
                     min_image_fraction: fraction,
                     min_pairs_per_image: per_image,
+                    min_pair_fraction: 0.0,
                 }),
             },
             model: CostModel::disambiguation(),

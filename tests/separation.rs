@@ -34,6 +34,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         rule: FlowRule::Criteria(Criteria {
             min_image_fraction: 0.8,
             min_pairs_per_image: 5.0,
+            min_pair_fraction: 0.0,
         }),
         model: all_priors(),
         unweighted_priors: true,

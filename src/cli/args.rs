@@ -38,6 +38,11 @@ pub enum Preset {
     /// selected; the paper's context and multiple motions at weight 0 (in --scores). Search: 80%
     /// of images, 5 pairs per image.
     Disambiguation,
+    /// The paper's section 5.1 as written, for its lab scenes: context similarity, loop
+    /// consistency and multiple motions with uniform weights, no fitness floor; search: 25% of
+    /// the view graph's pairs (its lab criterion), no image criterion. Relies on the pair arcs
+    /// following the capture order (--order).
+    PaperDisambiguation,
 }
 
 impl Preset {
@@ -45,6 +50,7 @@ impl Preset {
         match self {
             Preset::General => "general",
             Preset::Disambiguation => "disambiguation",
+            Preset::PaperDisambiguation => "paper-disambiguation",
         }
     }
 
@@ -52,14 +58,16 @@ impl Preset {
         match self {
             Preset::General => CostModel::general(),
             Preset::Disambiguation => CostModel::disambiguation(),
+            Preset::PaperDisambiguation => CostModel::paper_disambiguation(),
         }
     }
 
-    /// The paper's flow-search criteria: (image fraction, pairs per image).
-    pub fn criteria(self) -> (f64, f64) {
+    /// The paper's flow-search criteria: (image fraction, pairs per image, pair fraction).
+    pub fn criteria(self) -> (f64, f64, f64) {
         match self {
-            Preset::General => (0.9, 20.0),
-            Preset::Disambiguation => (0.8, 5.0),
+            Preset::General => (0.9, 20.0, 0.0),
+            Preset::Disambiguation => (0.8, 5.0, 0.0),
+            Preset::PaperDisambiguation => (0.0, 0.0, 0.25),
         }
     }
 }
@@ -68,7 +76,7 @@ impl Preset {
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
@@ -78,16 +86,22 @@ pub struct FlowArgs {
     /// [default: 20, disambiguation preset 5].
     #[arg(long, value_parser = non_negative)]
     min_pairs_per_image: Option<f64>,
+    /// Search: ... and at least this fraction of the view graph's pairs
+    /// [default: 0, paper-disambiguation preset 0.25].
+    #[arg(long, value_parser = fraction)]
+    min_pair_fraction: Option<f64>,
 }
 
 impl FlowArgs {
-    /// The flow rule, with `defaults` (image fraction, pairs per image) for unset criteria.
-    pub fn rule(&self, defaults: (f64, f64)) -> FlowRule {
+    /// The flow rule, with `defaults` (image fraction, pairs per image, pair fraction) for unset
+    /// criteria.
+    pub fn rule(&self, defaults: (f64, f64, f64)) -> FlowRule {
         match self.flow {
             Some(f) => FlowRule::Fixed(f),
             None => FlowRule::Criteria(Criteria {
                 min_image_fraction: self.min_image_fraction.unwrap_or(defaults.0),
                 min_pairs_per_image: self.min_pairs_per_image.unwrap_or(defaults.1),
+                min_pair_fraction: self.min_pair_fraction.unwrap_or(defaults.2),
             }),
         }
     }

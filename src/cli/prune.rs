@@ -163,6 +163,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         "flow": args.flow.flow,
         "min_image_fraction": criteria.map(|c| c.min_image_fraction),
         "min_pairs_per_image": criteria.map(|c| c.min_pairs_per_image),
+        "min_pair_fraction": criteria.map(|c| c.min_pair_fraction),
         "cost_model": options.model,
         "keep_pairs": path_text(&args.keep_pairs),
         "forbid_pairs": path_text(&args.forbid_pairs),
