@@ -9,7 +9,9 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 use opencv::core::{Mat, Point2d, Vector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use vgsel_colmap::geometry::{estimate_homography, homography_inliers, recover_pose, PoseSource};
+use vgsel_colmap::geometry::pose::{
+    estimate_homography, homography_inliers, recover_pose, PoseSource,
+};
 
 type Points = Vec<[f64; 2]>;
 

@@ -5,9 +5,10 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use vgsel_colmap::database::{Image, VerifiedPair};
-use vgsel_colmap::priors::{overlap, track_fraction, Inputs};
-use vgsel_colmap::view_graph::ViewGraph;
+use vgsel_colmap::colmap::database::{Image, VerifiedPair};
+use vgsel_colmap::priors::{overlap, track_fraction};
+use vgsel_colmap::scene::view_graph::ViewGraph;
+use vgsel_colmap::scene::Scene;
 
 const IMAGES: u32 = 300;
 const NEIGHBOURS: u32 = 20;
@@ -15,7 +16,7 @@ const KEYPOINTS: u32 = 2_000;
 const INLIERS: usize = 200;
 const SIZE: (u32, u32) = (1024, 768);
 
-fn scene() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
+fn two_copies() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     let images: Vec<Image> = (1..=IMAGES)
         .map(|id| Image {
@@ -55,23 +56,18 @@ fn scene() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
 }
 
 fn bench_priors(c: &mut Criterion) {
-    let (images, pairs, keypoints) = scene();
+    let (images, pairs, keypoints) = two_copies();
     let graph = ViewGraph::build(&images, &pairs, 15);
     // Vertices are image ids ascending, so vertex k is image k + 1: keypoints line up.
     assert_eq!(graph.image_ids.len(), IMAGES as usize);
-    let inputs = Inputs {
-        graph: &graph,
-        pairs: &pairs,
-        keypoints,
-        image_sizes: vec![SIZE; IMAGES as usize],
-    };
+    let scene = Scene::new(&graph, &pairs, keypoints, vec![SIZE; IMAGES as usize]);
     let mut group = c.benchmark_group("priors");
     group.sample_size(20);
     group.bench_function("overlap 300 images / 3000 pairs", |b| {
-        b.iter(|| overlap::compute(&inputs))
+        b.iter(|| overlap::compute(&scene))
     });
     group.bench_function("track fraction 300 images / 3000 pairs", |b| {
-        b.iter(|| track_fraction::compute(&inputs))
+        b.iter(|| track_fraction::compute(&scene))
     });
     group.finish();
 }

@@ -2,9 +2,9 @@
 //! (A = 0.9, B = 5, the benchmark criteria of docs/performance.md) and a fixed-F solve.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use vgsel_colmap::search::{search, Criteria, FlowRule};
-use vgsel_colmap::solver::solve;
-use vgsel_colmap::synthetic_graph::{generate, Arrangement};
+use vgsel_colmap::flow::search::{search, Criteria, FlowRule};
+use vgsel_colmap::flow::solver::solve;
+use vgsel_colmap::flow::synthetic_graph::{generate, Arrangement};
 
 fn bench_solver(c: &mut Criterion) {
     let mut group = c.benchmark_group("solver");

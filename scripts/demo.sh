@@ -10,7 +10,7 @@
 # NUM_IMAGES renders a larger scene (32 images: one COLMAP does not ghost).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+bash scripts/ci/install-deps.sh
 cargo build --release --quiet
 work=${1:-target/demo}
 rm -rf "$work"

@@ -8,11 +8,12 @@
 
 use crate::priors::PriorValues;
 use anyhow::{bail, Result};
-use serde::Serialize;
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer, Serialize};
 
 /// The normalisation g of one prior: a trapezoid with breakpoints k1..k6: `low` below k2, rising
 /// linearly to `high` on [k2, k3), `high` on [k3, k4], falling to `low` on (k4, k5), `low` above.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Trapezoid {
     /// Min-max scale the raw values to [0, 1] over all images (or pairs) first.
     pub minmax: bool,
@@ -114,8 +115,34 @@ pub struct PriorModel {
     pub weight: f64,
 }
 
+/// Read back from a run record: the name must be one of the priors a preset knows, so that it
+/// names the same measurement.
+impl<'de> Deserialize<'de> for PriorModel {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<PriorModel, D::Error> {
+        #[derive(Deserialize)]
+        struct Recorded {
+            name: String,
+            g: Trapezoid,
+            weight: f64,
+        }
+        let r = Recorded::deserialize(d)?;
+        let known = [CostModel::general(), CostModel::disambiguation()];
+        let name = known
+            .iter()
+            .flat_map(|m| m.image_priors.iter().chain(&m.pair_priors))
+            .map(|p| p.name)
+            .find(|&n| n == r.name)
+            .ok_or_else(|| D::Error::custom(format!("unknown prior `{}`", r.name)))?;
+        Ok(PriorModel {
+            name,
+            g: r.g,
+            weight: r.weight,
+        })
+    }
+}
+
 /// A preset: which priors, their g and weights.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CostModel {
     pub image_priors: Vec<PriorModel>,
     pub pair_priors: Vec<PriorModel>,

@@ -1,38 +1,18 @@
 //! vgsel-colmap: view-graph selection for COLMAP databases.
 //!
-//! Data flows one way: [`database`] reads a COLMAP database, [`view_graph`] builds the graph of
-//! verified pairs, [`priors`] measure images and pairs, [`costs`] turn measurements into arc costs,
-//! [`network`] and [`solver`] find the min-cost flow of the paper (Shah, Chari, Narayanan),
-//! [`search`] picks the flow, and [`rewrite`] invalidates the unselected pairs, reversibly.
-//! [`prune`] runs that pipeline; [`report`] describes what it did.
+//! Data flows one way: [`colmap`] reads a COLMAP database, [`scene`] holds its view graph,
+//! [`geometry`] and [`priors`] measure images and pairs, [`costs`] turn measurements into arc
+//! costs, [`flow`] finds the min-cost flow of the paper (Shah, Chari, Narayanan) and the flow F,
+//! [`selection`] runs that pipeline, [`colmap::rewrite`] invalidates the unselected pairs,
+//! reversibly, and [`outputs`] describe what was done. [`eval`] is the evaluation tooling.
 
-pub mod align;
-pub mod camera;
-pub mod capture_order;
+pub mod colmap;
 pub mod costs;
-pub mod database;
-pub mod duplicate_scene;
+#[cfg(feature = "eval")]
 pub mod eval;
-pub mod export;
-pub mod focal;
+pub use vgsel_flow as flow;
 pub mod geometry;
-pub mod graph_file;
-pub mod model;
-pub mod network;
-pub mod overrides;
-pub mod pair_truth;
-pub mod plots;
+pub mod outputs;
 pub mod priors;
-pub mod progress;
-pub mod prune;
-pub mod render;
-pub mod report;
-pub mod rewrite;
-pub mod scores;
-pub mod search;
-pub mod separation;
-pub mod solver;
-pub mod synth;
-pub mod synthetic_graph;
-pub mod view_geometry;
-pub mod view_graph;
+pub mod scene;
+pub mod selection;

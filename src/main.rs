@@ -2,9 +2,9 @@
 
 mod cli;
 
+use crate::cli::progress::Progress;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
-use vgsel_colmap::progress::Progress;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -49,6 +49,8 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+// Parsed once per run: the size of the largest variant costs nothing.
+#[allow(clippy::large_enum_variant)]
 enum Command {
     /// Keep only the selected pairs valid in two_view_geometries (reversible).
     #[command(after_help = "Examples:
@@ -56,7 +58,7 @@ enum Command {
   vgsel-colmap prune --database_path db.db --dry_run -v --min_pairs_per_image 10
   vgsel-colmap prune --database_path db.db --output pruned.db --pairs_out pairs.txt \\
       --keep_pairs keep.txt --forbid_images bad_images.txt")]
-    Prune(Box<cli::prune::PruneArgs>),
+    Prune(cli::prune::PruneArgs),
     /// Put back every pair a prune invalidated, byte for byte, and drop vgsel-colmap's tables.
     Restore(cli::args::DatabaseArg),
     /// Print the view graph's figures.
@@ -64,8 +66,10 @@ enum Command {
     /// Run the selection solver on a plain-text graph (benchmarks, solver-only users).
     Solve(cli::solve::SolveArgs),
     /// Score a reconstruction against ground-truth poses; prints JSON.
+    #[cfg(feature = "eval")]
     Eval(cli::eval::EvalArgs),
     /// Write synthetic test data: a matched COLMAP database, or a view graph for `solve`.
+    #[cfg(feature = "eval")]
     #[command(subcommand)]
     Generate(cli::generate::GenerateCommand),
     /// Write the view graph with each pair's priors, cost and kept/removed, for Graphviz or networkx.
@@ -113,7 +117,9 @@ fn main() -> ExitCode {
         Command::Restore(args) => cli::restore::run(&args, quiet),
         Command::Inspect(args) => cli::inspect::run(&args),
         Command::Solve(args) => cli::solve::run(&args),
+        #[cfg(feature = "eval")]
         Command::Eval(args) => cli::eval::run(&args),
+        #[cfg(feature = "eval")]
         Command::Generate(command) => cli::generate::run(&command),
         Command::Export(args) => cli::export::run(&args, quiet, &progress),
         Command::Completions { shell } => {

@@ -1,12 +1,10 @@
 //! The `vgsel-colmap` binary end to end on generated databases: what prune writes, that restore
 //! undoes it byte for byte, and that bad input fails with one line and leaves files untouched.
 
-mod common;
-
-use common::{dump, ok, scene, schema, table_names, user_version, vgsel};
+use crate::support::{dump, ok, scene, schema, table_names, user_version, vgsel};
 use rusqlite::types::Value;
 use std::path::Path;
-use vgsel_colmap::database::image_ids;
+use vgsel_colmap::colmap::ids::image_ids;
 
 /// Fails with exit status 1 and one error line on stderr, the last (progress lines may precede
 /// it); returns that line.

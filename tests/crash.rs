@@ -7,17 +7,15 @@
 //! rollback journal appears (the write transaction has begun) and then fall at a uniform time
 //! over the write's measured length, so the write is hit by real timing, without hooks.
 //! VGSEL_CRASH_RUNS (default 20) and VGSEL_CRASH_IMAGES (default 40) make longer runs; see
-//! scripts/crash-test.sh.
+//! scripts/ci/crash-test.sh.
 
-mod common;
-
-use common::{dump, schema, table_names, Row};
+use crate::support::{dump, schema, table_names, Row};
 use rand::{Rng, SeedableRng};
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-use vgsel_colmap::synth::{generate, SceneSpec};
+use vgsel_colmap::eval::synth::{generate, SceneSpec};
 
 const PRUNE: [&str; 3] = ["--min_pairs_per_image", "4", "-q"];
 
@@ -83,7 +81,7 @@ fn colmap_reads(db: &Path, scratch: &Path) {
         .arg("--merged_database_path")
         .arg(scratch.join("merged.db"))
         .output()
-        .expect("running colmap (scripts/install-deps.sh installs it)");
+        .expect("running colmap (scripts/ci/install-deps.sh installs it)");
     assert!(
         out.status.success(),
         "colmap cannot read {db:?}: {}",
@@ -112,7 +110,7 @@ fn mapper_loads_valid_pairs(db: &Path, scratch: &Path) {
             "0",
         ])
         .output()
-        .expect("running colmap (scripts/install-deps.sh installs it)");
+        .expect("running colmap (scripts/ci/install-deps.sh installs it)");
     let log =
         String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     let loaded: i64 = log

@@ -1,12 +1,11 @@
 //! Reading COLMAP databases of both layouts, and every error the reader must raise.
 
-mod common;
-
-use common::Layout; // not database::Layout
-use common::*;
+use crate::support::Layout; // not database::Layout
+use crate::support::*;
 use rusqlite::{params, Connection};
 use std::time::Duration;
-use vgsel_colmap::database::*;
+use vgsel_colmap::colmap::database::*;
+use vgsel_colmap::colmap::ids::*;
 
 fn err<T>(r: anyhow::Result<T>) -> String {
     match r {

@@ -7,7 +7,7 @@
 
 use serde_json::Value;
 use std::process::Command;
-use vgsel_colmap::render::{Scene, SceneKind};
+use vgsel_colmap::eval::render::{Scene, SceneKind};
 
 #[test]
 fn rendered_duplicate_scene_through_colmap() {

@@ -3,8 +3,8 @@
 
 use nalgebra::{Rotation3, Vector3};
 use std::path::Path;
-use vgsel_colmap::eval::score;
-use vgsel_colmap::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
+use vgsel_colmap::eval::score::score;
+use vgsel_colmap::eval::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
 
 fn truth(dir: &Path) -> GroundTruth {
     let spec = SceneSpec {

@@ -1,11 +1,11 @@
 //! Focal-length estimation on a generated database whose camera carries COLMAP's guess
 //! (1.2 × max(width, height), prior_focal_length = 0) and UNCALIBRATED geometries.
 
+use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::costs::CostModel;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::prune::{plan, Options};
-use vgsel_colmap::search::FlowRule;
-use vgsel_colmap::synth::{generate, SceneSpec};
+use vgsel_colmap::eval::synth::{generate, SceneSpec};
+use vgsel_colmap::flow::search::FlowRule;
+use vgsel_colmap::selection::pipeline::{plan, Options};
 
 #[test]
 fn guessed_focal_length_is_replaced_by_the_estimate() {
@@ -25,6 +25,7 @@ fn guessed_focal_length_is_replaced_by_the_estimate() {
         rule: FlowRule::Fixed(4),
         model: CostModel::general(),
         unweighted_priors: false,
+        curve_factor: 0,
         capture: Default::default(),
     };
     let p = plan(&db, &options, &|_| {}).unwrap();

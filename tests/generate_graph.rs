@@ -2,8 +2,8 @@
 //! same arguments, byte for byte, and a solvable file.
 
 use std::process::Command;
-use vgsel_colmap::graph_file;
-use vgsel_colmap::synthetic_graph::{generate, Arrangement};
+use vgsel_colmap::flow::graph_file;
+use vgsel_colmap::flow::synthetic_graph::{generate, Arrangement};
 
 fn run(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))

@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use vgsel_colmap::align::evaluate;
-use vgsel_colmap::model::read_images;
-use vgsel_colmap::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
+use vgsel_colmap::colmap::model::read_images;
+use vgsel_colmap::eval::align::evaluate;
+use vgsel_colmap::eval::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
 
 fn colmap() -> Command {
     let ok = Command::new("colmap")

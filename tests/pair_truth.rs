@@ -2,8 +2,8 @@
 //! known: every pair is true under the right poses, and most are false under turned poses.
 
 use nalgebra::Rotation3;
-use vgsel_colmap::pair_truth::report;
-use vgsel_colmap::synth::{generate, write_gt_model, SceneSpec};
+use vgsel_colmap::eval::pair_truth::report;
+use vgsel_colmap::eval::synth::{generate, write_gt_model, SceneSpec};
 
 #[test]
 fn pairs_are_true_under_the_true_poses_and_false_under_turned_cameras() {

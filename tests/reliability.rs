@@ -2,17 +2,15 @@
 //! error line naming the problem and exit status 1 (or behaves as documented), never panics, and
 //! leaves every file in the database's directory byte for byte as it was whenever it fails.
 
-mod common;
-
-use common::{dump, exec, fixture, ok, scene, table_names, vgsel, Layout};
+use crate::support::{dump, exec, fixture, ok, scene, table_names, vgsel, Layout};
 use rusqlite::Connection;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 use tempfile::TempDir;
-use vgsel_colmap::database::image_ids;
-use vgsel_colmap::synth::{generate, SceneSpec};
+use vgsel_colmap::colmap::ids::image_ids;
+use vgsel_colmap::eval::synth::{generate, SceneSpec};
 
 /// Every file under `dir` (names relative to it) with its bytes.
 fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
@@ -299,7 +297,7 @@ impl LockHolder {
             .stdin(std::process::Stdio::piped())
             .stdout(std::process::Stdio::piped())
             .spawn()
-            .expect("running sqlite3 (scripts/install-deps.sh installs it)");
+            .expect("running sqlite3 (scripts/ci/install-deps.sh installs it)");
         let stdin = child.stdin.as_mut().unwrap();
         writeln!(stdin, "{begin}; SELECT 'locked';").unwrap();
         let mut line = String::new();

@@ -1,18 +1,17 @@
 //! The reversible rewrite: exact invalidation, idempotence, restore byte for byte, rollback.
 
-mod common;
-
-use common::*;
+use crate::support::*;
 use rusqlite::types::Value;
 use rusqlite::Connection;
 use std::path::Path;
 use std::time::Duration;
-use vgsel_colmap::database::{pair_id, Database};
-use vgsel_colmap::rewrite::{apply, copy_database, last_run, restore, RunRecord};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::ids::pair_id;
+use vgsel_colmap::colmap::rewrite::{apply, copy_database, last_run, restore, RunRecord};
 
-fn run(n: usize) -> RunRecord {
+fn run(n: usize) -> RunRecord<serde_json::Value> {
     RunRecord {
-        parameters: format!("{{\"k\":{n}}}"),
+        parameters: serde_json::json!({ "k": n }),
         flow: Some(n as u64),
         images_total: 4,
         images_selected: 4,
@@ -66,7 +65,7 @@ fn apply_invalidates_exactly_the_given_pairs() {
         let ncols = after[0].len();
         assert_eq!(ncols, if layout == Layout::Latest { 12 } else { 10 });
         for (before, now) in tvg.iter().zip(&after) {
-            let pair = vgsel_colmap::database::image_ids(match now[0].1 {
+            let pair = vgsel_colmap::colmap::ids::image_ids(match now[0].1 {
                 Value::Integer(i) => i as u64,
                 _ => panic!(),
             });
@@ -115,15 +114,16 @@ fn apply_invalidates_exactly_the_given_pairs() {
 fn run_record_is_written() {
     let (_dir, path) = fixture(Layout::V38);
     let db = Database::open(&path).unwrap();
-    assert_eq!(last_run(&db).unwrap(), None);
+    assert_eq!(last_run::<serde_json::Value>(&db).unwrap(), None);
     drop(db);
     prune(&path, &A);
     prune(&path, &B);
     let db = Database::open(&path).unwrap();
-    let r = last_run(&db).unwrap().unwrap();
-    assert_eq!(r.run_id, 2);
-    assert_eq!(r.tool_version, env!("CARGO_PKG_VERSION"));
-    assert_eq!(r.parameters, "{\"k\":2}");
+    let row = last_run::<serde_json::Value>(&db).unwrap().unwrap();
+    assert_eq!(row.run_id, 2);
+    assert_eq!(row.tool_version, env!("CARGO_PKG_VERSION"));
+    let r = row.run;
+    assert_eq!(r.parameters, serde_json::json!({ "k": 2 }));
     assert_eq!(r.flow, Some(2));
     assert_eq!(
         (
@@ -135,11 +135,11 @@ fn run_record_is_written() {
         (4, 4, 4, 2)
     );
     // 2024-05-01T12:00:00Z
-    assert_eq!(r.time.len(), 20, "{}", r.time);
+    assert_eq!(row.time.len(), 20, "{}", row.time);
     assert!(
-        r.time.ends_with('Z') && r.time.as_bytes()[10] == b'T',
+        row.time.ends_with('Z') && row.time.as_bytes()[10] == b'T',
         "{}",
-        r.time
+        row.time
     );
 }
 

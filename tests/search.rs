@@ -3,9 +3,11 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashSet;
-use vgsel_colmap::network::{PairArc, Selection, SelectionProblem};
-use vgsel_colmap::search::{search, targets, Criteria, FlowRule, SearchResult};
-use vgsel_colmap::solver::{solve, ParametricSolver};
+use vgsel_colmap::flow::network::{PairArc, Selection, SelectionProblem};
+use vgsel_colmap::flow::search::{
+    search, search_with_curve, targets, Criteria, FlowRule, SearchResult,
+};
+use vgsel_colmap::flow::solver::{solve, ParametricSolver};
 
 fn random_problem(n: usize, m: usize, seed: u64) -> SelectionProblem {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -41,7 +43,7 @@ fn criteria(a: f64, b: f64) -> FlowRule {
     })
 }
 
-fn status<'a>(r: &'a SearchResult, name: &str) -> &'a vgsel_colmap::search::CriterionStatus {
+fn status<'a>(r: &'a SearchResult, name: &str) -> &'a vgsel_colmap::flow::search::CriterionStatus {
     r.criteria.iter().find(|c| c.name == name).unwrap()
 }
 
@@ -210,4 +212,39 @@ fn the_pair_fraction_raises_the_pair_target_and_the_flow() {
     assert!(pairs >= 175 && status(&r, "pairs").binding);
     let (_, before) = counts(&solve(&p, r.selection.flow - 1));
     assert!(before < 175);
+}
+
+#[test]
+fn curve_beyond_the_choice_continues_the_same_flows_and_keeps_the_selection() {
+    for seed in 0..20 {
+        let problem = random_problem(12, 30, seed);
+        for rule in [criteria(0.6, 1.0), FlowRule::Fixed(3), criteria(1.0, 30.0)] {
+            let plain = search(&problem, &rule);
+            let extended = search_with_curve(&problem, &rule, 4);
+            assert_eq!(extended.selection, plain.selection, "seed {seed}");
+            assert_eq!(extended.curve.len(), plain.curve.len());
+            // Every point, chosen or beyond, is what a fresh solver selects at that F.
+            let mut fresh = ParametricSolver::new(&problem);
+            for p in extended.curve.iter().chain(&extended.beyond) {
+                while fresh.flow() < p.flow {
+                    fresh.augment().expect("the search reached this flow");
+                }
+                assert_eq!(
+                    (p.images_selected, p.pairs_selected),
+                    (fresh.images_selected(), fresh.pairs_selected()),
+                    "seed {seed}, F = {}",
+                    p.flow
+                );
+            }
+            let chosen = plain.selection.flow.max(1);
+            let last = extended.beyond.last().or(extended.curve.last()).unwrap();
+            let limit = (4 * chosen).min(2 * problem.pairs.len() as u64);
+            assert!(
+                last.flow >= limit.min(fresh.max_flow())
+                    || last.pairs_selected == problem.pairs.len(),
+                "seed {seed}: the curve stops early at F = {}",
+                last.flow
+            );
+        }
+    }
 }

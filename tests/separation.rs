@@ -4,12 +4,12 @@
 //! bigger scene (`cargo test --release --test separation -- --ignored --nocapture`).
 
 use std::time::Instant;
+use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::costs::CostModel;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::prune::{plan, Options, Plan};
-use vgsel_colmap::search::{Criteria, FlowRule};
-use vgsel_colmap::separation::{measure, Separation};
-use vgsel_colmap::synth::{generate, GroundTruth, Layout, SceneSpec};
+use vgsel_colmap::eval::separation::{measure, Separation};
+use vgsel_colmap::eval::synth::{generate, GroundTruth, Layout, SceneSpec};
+use vgsel_colmap::flow::search::{Criteria, FlowRule};
+use vgsel_colmap::selection::pipeline::{plan, Options, Plan};
 
 /// The disambiguation preset plus the general preset's pair priors at weight 0, so that one run
 /// measures every pair prior.
@@ -38,6 +38,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         }),
         model: all_priors(),
         unweighted_priors: true,
+        curve_factor: 0,
         capture: Default::default(),
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();

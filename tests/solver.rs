@@ -9,9 +9,9 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use std::collections::HashSet;
 use std::time::Instant;
-use vgsel_colmap::network::{PairArc, Selection, SelectionProblem};
-use vgsel_colmap::search::{search, Criteria, FlowRule};
-use vgsel_colmap::solver::{scale_cost, solve, ParametricSolver};
+use vgsel_colmap::flow::network::{PairArc, Selection, SelectionProblem};
+use vgsel_colmap::flow::search::{search, Criteria, FlowRule};
+use vgsel_colmap::flow::solver::{scale_cost, solve, ParametricSolver};
 
 fn degrees(p: &SelectionProblem) -> Vec<u64> {
     let mut deg = vec![0u64; p.image_costs.len()];
@@ -466,9 +466,9 @@ fn timing_parse_5m_pairs() {
         image_costs: vec![-0.5; n as usize],
         pairs,
     };
-    let text = vgsel_colmap::graph_file::write(&p);
+    let text = vgsel_colmap::flow::graph_file::write(&p);
     let t0 = Instant::now();
-    let q = vgsel_colmap::graph_file::parse(&text).unwrap();
+    let q = vgsel_colmap::flow::graph_file::parse(&text).unwrap();
     println!(
         "parse 10K images / 5M pairs ({} MB): {:.3} s",
         text.len() >> 20,

@@ -4,9 +4,9 @@ use nalgebra::{Matrix3, Vector3};
 use rusqlite::{Connection, OptionalExtension};
 use std::collections::HashSet;
 use std::path::Path;
-use vgsel_colmap::align::evaluate;
-use vgsel_colmap::model::read_images;
-use vgsel_colmap::synth::{generate, pair_geometry, write_gt_model, GroundTruth, SceneSpec};
+use vgsel_colmap::colmap::model::read_images;
+use vgsel_colmap::eval::align::evaluate;
+use vgsel_colmap::eval::synth::{generate, pair_geometry, write_gt_model, GroundTruth, SceneSpec};
 
 const BASE: u64 = 2_147_483_647;
 

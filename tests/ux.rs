@@ -2,9 +2,7 @@
 //! pair list, the graph exports (checked by Graphviz and networkx when installed), the overrides,
 //! progress output, completions and the man page.
 
-mod common;
-
-use common::{ok, scene, vgsel};
+use crate::support::{ok, scene, vgsel};
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;
@@ -356,4 +354,78 @@ fn the_capture_order_is_reported_and_exif_needs_the_images() {
         "{err}"
     );
     assert_eq!(std::fs::read(&db).unwrap(), before);
+}
+
+/// The `cost` attribute of every DOT edge, keyed by the edge's image ids.
+fn dot_costs(dot: &str) -> std::collections::BTreeMap<(u32, u32), f64> {
+    let attr = |line: &str, key: &str| -> String {
+        let at = [' ', '[']
+            .iter()
+            .find_map(|c| line.find(&format!("{c}{key}=\"")))
+            .unwrap()
+            + key.len()
+            + 3;
+        line[at..].split('"').next().unwrap().to_string()
+    };
+    let ids: std::collections::HashMap<String, u32> = dot
+        .lines()
+        .filter(|l| l.contains("image_id=") && !l.contains(" -- "))
+        .map(|l| {
+            (
+                l.trim().split('"').nth(1).unwrap().to_string(),
+                attr(l, "image_id").parse().unwrap(),
+            )
+        })
+        .collect();
+    dot.lines()
+        .filter(|l| l.contains(" -- "))
+        .map(|l| {
+            let names: Vec<&str> = l.trim().split('"').collect();
+            let (a, b) = (ids[names[1]], ids[names[3]]);
+            ((a.min(b), a.max(b)), attr(l, "cost").parse().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn export_shows_the_costs_that_drove_the_selection() {
+    // Pruned with the disambiguation preset and a weight override: the exported costs must be
+    // those of that cost model (as --scores wrote them), not the general preset's.
+    let (dir, db) = scene();
+    let pruned = dir.path().join("pruned.db");
+    let scores = dir.path().join("scores.csv");
+    ok(&[
+        "prune",
+        "--database_path",
+        s(&db),
+        "--output",
+        s(&pruned),
+        "--preset",
+        "disambiguation",
+        "--weights",
+        "loop_fraction=2",
+        "--scores",
+        s(&scores),
+        "-q",
+    ]);
+    let csv = std::fs::read_to_string(&scores).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let cost_column = header.iter().position(|&h| h == "cost").unwrap();
+    let expected: std::collections::BTreeMap<(u32, u32), f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (
+                (f[0].parse().unwrap(), f[1].parse().unwrap()),
+                f[cost_column].parse().unwrap(),
+            )
+        })
+        .collect();
+    let exported = dot_costs(&export(&pruned, "dot", &dir.path().join("g.dot")));
+    assert_eq!(exported, expected);
+    // And they differ from the general preset's, so the check above can fail.
+    let general = dot_costs(&export(&db, "dot", &dir.path().join("general.dot")));
+    assert_eq!(general.len(), expected.len());
+    assert_ne!(general, expected);
 }

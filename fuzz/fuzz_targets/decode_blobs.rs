@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use vgsel_colmap::database::{decode_f64_array, decode_keypoints_xy, decode_mat3, decode_matches};
+use vgsel_colmap::colmap::database::{decode_f64_array, decode_keypoints_xy, decode_mat3, decode_matches};
 
 fuzz_target!(|input: &[u8]| {
     if input.len() < 3 {

@@ -3,8 +3,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use vgsel_colmap::graph_file::{parse, write};
-use vgsel_colmap::search::{search, FlowRule};
+use vgsel_colmap::flow::graph_file::{parse, write};
+use vgsel_colmap::flow::search::{search, FlowRule};
 
 fuzz_target!(|input: &[u8]| {
     let Ok(text) = std::str::from_utf8(input) else {

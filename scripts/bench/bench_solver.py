@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Solver benchmark: vgsel-colmap's search against LEMON, OR-tools and networkx peers, on the same
 paper-style synthetic graph files, in one run. Prints a markdown table of median seconds and
-ratios (peer / ours). Run through scripts/bench-solver.sh, which installs and builds everything.
+ratios (peer / ours). Run through scripts/bench/solver.sh, which installs and builds everything.
 
 usage: bench_solver.py BIN LEMON_DRIVER WORKDIR [--sizes 300x10000,1000x100000] [--repeats 3]
 """

@@ -2,12 +2,11 @@
 //! value parsers that check option values.
 
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::path::PathBuf;
 use std::time::Duration;
-use vgsel_colmap::costs::CostModel;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::search::{Criteria, FlowRule};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::flow::search::FlowRule;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -25,50 +24,6 @@ impl DatabaseArg {
     pub fn open(&self, read_only: bool) -> Result<Database> {
         let timeout = Duration::from_secs_f64(self.lock_timeout);
         Database::open_with_lock_timeout(&self.database_path, read_only, timeout)
-    }
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-pub enum Preset {
-    /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
-    /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
-    General,
-    /// For scenes with duplicate or symmetric structure: pair priors loop consistency (rotations
-    /// and translations of every triangle) and unique tracks, pairs below fitness 0.6 never
-    /// selected; the paper's context and multiple motions at weight 0 (in --scores). Search: 80%
-    /// of images, 5 pairs per image.
-    Disambiguation,
-    /// The paper's section 5.1 as written, for its lab scenes: context similarity, loop
-    /// consistency and multiple motions with uniform weights, no fitness floor; search: 25% of
-    /// the view graph's pairs (its lab criterion), no image criterion. Relies on the pair arcs
-    /// following the capture order (--order).
-    PaperDisambiguation,
-}
-
-impl Preset {
-    pub fn name(self) -> &'static str {
-        match self {
-            Preset::General => "general",
-            Preset::Disambiguation => "disambiguation",
-            Preset::PaperDisambiguation => "paper-disambiguation",
-        }
-    }
-
-    pub fn model(self) -> CostModel {
-        match self {
-            Preset::General => CostModel::general(),
-            Preset::Disambiguation => CostModel::disambiguation(),
-            Preset::PaperDisambiguation => CostModel::paper_disambiguation(),
-        }
-    }
-
-    /// The paper's flow-search criteria: (image fraction, pairs per image, pair fraction).
-    pub fn criteria(self) -> (f64, f64, f64) {
-        match self {
-            Preset::General => (0.9, 20.0, 0.0),
-            Preset::Disambiguation => (0.8, 5.0, 0.0),
-            Preset::PaperDisambiguation => (0.0, 0.0, 0.25),
-        }
     }
 }
 
@@ -96,16 +51,32 @@ impl FlowArgs {
     /// The flow rule, with `defaults` (image fraction, pairs per image, pair fraction) for unset
     /// criteria.
     pub fn rule(&self, defaults: (f64, f64, f64)) -> FlowRule {
-        match self.flow {
-            Some(f) => FlowRule::Fixed(f),
-            None => FlowRule::Criteria(Criteria {
-                min_image_fraction: self.min_image_fraction.unwrap_or(defaults.0),
-                min_pairs_per_image: self.min_pairs_per_image.unwrap_or(defaults.1),
-                min_pair_fraction: self.min_pair_fraction.unwrap_or(defaults.2),
-            }),
+        FlowRule::new(
+            self.flow,
+            self.min_image_fraction,
+            self.min_pairs_per_image,
+            self.min_pair_fraction,
+            defaults,
+        )
+    }
+
+    /// The parameters' view of these options: (fixed flow, image fraction, pairs per image, pair
+    /// fraction), the criteria filled from `defaults` unless the flow is fixed.
+    pub fn parts(&self, defaults: (f64, f64, f64)) -> FlowParts {
+        match self.rule(defaults) {
+            FlowRule::Fixed(f) => (Some(f), None, None, None),
+            FlowRule::Criteria(c) => (
+                None,
+                Some(c.min_image_fraction),
+                Some(c.min_pairs_per_image),
+                Some(c.min_pair_fraction),
+            ),
         }
     }
 }
+
+/// (fixed flow, image fraction, pairs per image, pair fraction) as the parameters record them.
+pub type FlowParts = (Option<u64>, Option<f64>, Option<f64>, Option<f64>);
 
 #[derive(Clone, Debug)]
 pub struct Weights(pub Vec<(String, f64)>);

@@ -4,8 +4,8 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::{eval, pair_truth};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::eval::{pair_truth, score as eval};
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -29,7 +29,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "FILE", requires_all = ["database_path", "ground_truth"])]
     labels: Option<PathBuf>,
     /// A pair is used by the mapper with at least this many inliers (--Mapper.min_num_matches).
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = vgsel_colmap::selection::pipeline::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
 }
 

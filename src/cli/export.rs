@@ -2,12 +2,12 @@
 //! Graphviz or networkx.
 
 use super::args::DatabaseArg;
+use crate::cli::progress::Progress;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use vgsel_colmap::database::Database;
-use vgsel_colmap::export;
-use vgsel_colmap::progress::Progress;
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::outputs::export;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]

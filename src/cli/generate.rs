@@ -4,7 +4,8 @@
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use std::path::PathBuf;
-use vgsel_colmap::{graph_file, render, synth, synthetic_graph};
+use vgsel_colmap::eval::{render, synth};
+use vgsel_colmap::flow::{graph_file, synthetic_graph};
 
 #[derive(Subcommand)]
 pub enum GenerateCommand {

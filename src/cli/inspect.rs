@@ -11,7 +11,7 @@ pub struct InspectArgs {
     #[command(flatten)]
     database: DatabaseArg,
     /// A pair counts when it has at least this many verified inliers (as --Mapper.min_num_matches).
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = vgsel_colmap::selection::pipeline::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -22,7 +22,8 @@ pub fn run(args: &InspectArgs) -> Result<()> {
     let db = args.database.open(true)?;
     let images = db.images()?;
     let pairs = db.verified_pairs()?;
-    let graph = vgsel_colmap::view_graph::ViewGraph::build(&images, &pairs, args.min_num_matches);
+    let graph =
+        vgsel_colmap::scene::view_graph::ViewGraph::build(&images, &pairs, args.min_num_matches);
     let stats = graph.stats();
     let pruned = db.is_pruned()?;
     if args.json {

@@ -6,10 +6,13 @@
 //! [`dashed_aliases`] adds the dashed spelling (`--num-images`) as a visible alias.
 
 pub mod args;
+#[cfg(feature = "eval")]
 pub mod eval;
 pub mod export;
+#[cfg(feature = "eval")]
 pub mod generate;
 pub mod inspect;
+pub mod progress;
 pub mod prune;
 pub mod restore;
 pub mod solve;

@@ -1,21 +1,21 @@
 //! `prune`: selects the pairs the mapper should use and invalidates the others in
 //! two_view_geometries, in place (reversible by `restore`) or in a copy.
 
-use super::args::{fraction, weights, DatabaseArg, FlowArgs, Preset, Weights};
+use super::args::{fraction, weights, DatabaseArg, FlowArgs, Weights};
+use crate::cli::progress::Progress;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use vgsel_colmap::capture_order::{self, Order};
-use vgsel_colmap::database::Database;
-use vgsel_colmap::overrides::{NameList, Overrides};
-use vgsel_colmap::progress::Progress;
-use vgsel_colmap::search::FlowRule;
-use vgsel_colmap::{
-    export, plots, prune,
-    report::{Outputs, Report},
-    rewrite, scores,
-};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::rewrite;
+use vgsel_colmap::outputs::report::{Outputs, Report};
+use vgsel_colmap::outputs::{export, plots, scores};
+use vgsel_colmap::selection::capture_order::Order;
+use vgsel_colmap::selection::overrides::{NameList, Overrides};
+use vgsel_colmap::selection::parameters::Parameters;
+use vgsel_colmap::selection::pipeline as prune;
+use vgsel_colmap::selection::preset::Preset;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -34,7 +34,7 @@ pub struct PruneArgs {
     #[arg(long)]
     dry_run: bool,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
-    #[arg(long, default_value_t = 15)]
+    #[arg(long, default_value_t = prune::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
     /// Which priors make the costs.
     #[arg(long, value_enum, default_value = "general")]
@@ -131,16 +131,27 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     if let Some(floor) = args.min_pair_fitness {
         model.min_pair_fitness = floor;
     }
-    let options = prune::Options {
+    let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
+    let (flow, min_image_fraction, min_pairs_per_image, min_pair_fraction) =
+        args.flow.parts(args.preset.criteria());
+    let parameters = Parameters {
+        preset: args.preset,
+        cost_model: model,
         min_num_matches: args.min_num_matches,
-        rule: args.flow.rule(args.preset.criteria()),
-        model,
-        unweighted_priors: args.scores.is_some(),
-        capture: capture_order::Input {
-            order: args.order,
-            image_path: args.image_path.clone(),
-        },
+        flow,
+        min_image_fraction,
+        min_pairs_per_image,
+        min_pair_fraction,
+        order: args.order,
+        image_path: path_text(&args.image_path),
+        keep_pairs: path_text(&args.keep_pairs),
+        forbid_pairs: path_text(&args.forbid_pairs),
+        forbid_images: path_text(&args.forbid_images),
     };
+    let mut options = parameters.options(args.scores.is_some());
+    if args.plots.is_some() {
+        options.curve_factor = plots::CURVE_FACTOR;
+    }
     let stage = |s: &str| progress.stage(s);
     let overrides = args.overrides()?;
     let mut plan = prune::plan_with(&db, &options, &overrides, &stage)?;
@@ -152,24 +163,6 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         plan.network.problem.pairs.len(),
         plan.search.selection.flow
     ));
-    let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
-    let criteria = match options.rule {
-        FlowRule::Criteria(c) => Some(c),
-        FlowRule::Fixed(_) => None,
-    };
-    let parameters = serde_json::json!({
-        "preset": args.preset.name(),
-        "min_num_matches": args.min_num_matches,
-        "flow": args.flow.flow,
-        "min_image_fraction": criteria.map(|c| c.min_image_fraction),
-        "min_pairs_per_image": criteria.map(|c| c.min_pairs_per_image),
-        "min_pair_fraction": criteria.map(|c| c.min_pair_fraction),
-        "cost_model": options.model,
-        "keep_pairs": path_text(&args.keep_pairs),
-        "forbid_pairs": path_text(&args.forbid_pairs),
-        "forbid_images": path_text(&args.forbid_images),
-        "order": args.order,
-    });
     // The extra files first: if one cannot be written, the database is still untouched.
     let mut outputs = Outputs::default();
     if let Some(path) = &args.pairs_out {
@@ -181,7 +174,8 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         scores::write(&plan, path)?;
     }
     if let Some(dir) = &args.plots {
-        let files = plots::write(&plan, dir, progress)?;
+        progress.stage("drawing plots");
+        let files = plots::write(&plan, dir)?;
         outputs.plots = files.iter().map(|f| f.display().to_string()).collect();
     }
     let written_to = if args.dry_run {
@@ -190,7 +184,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         stage("writing two_view_geometries");
         let t = Instant::now();
         let run = rewrite::RunRecord {
-            parameters: parameters.to_string(),
+            parameters: parameters.clone(),
             flow: Some(plan.search.selection.flow),
             images_total: plan.images.len(),
             images_selected: plan.search.selection.images.iter().filter(|&&s| s).count(),
@@ -212,7 +206,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         plan.timings.total += plan.timings.write;
         Some(target.display().to_string())
     };
-    let mut report = Report::new(&plan, input.display().to_string(), written_to, parameters);
+    let mut report = Report::new(&plan, input.display().to_string(), written_to, &parameters);
     report.outputs = outputs;
     progress.finish();
     if let Some(path) = &args.report {
@@ -232,7 +226,7 @@ fn write_pruned_copy(
     input: &Path,
     out: &Path,
     invalidate: &[u64],
-    run: &rewrite::RunRecord,
+    run: &rewrite::RunRecord<Parameters>,
 ) -> Result<()> {
     let name = out
         .file_name()

@@ -2,7 +2,7 @@
 
 use super::args::DatabaseArg;
 use anyhow::Result;
-use vgsel_colmap::rewrite;
+use vgsel_colmap::colmap::rewrite;
 
 pub fn run(args: &DatabaseArg, quiet: bool) -> Result<()> {
     let mut db = args.open(false)?;

@@ -1,12 +1,13 @@
 //! `solve`: runs the selection solver on a plain-text graph file and prints the result as
 //! JSON (benchmarks, solver-only users).
 
-use super::args::{FlowArgs, Preset};
+use super::args::FlowArgs;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
-use vgsel_colmap::{graph_file, search};
+use vgsel_colmap::flow::{graph_file, search};
+use vgsel_colmap::selection::preset::Preset;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]

@@ -3,7 +3,7 @@
 //! collections); such bridging images have a *low* coefficient, so the fitness is its complement.
 
 use super::PriorValues;
-use crate::view_graph::ViewGraph;
+use crate::scene::view_graph::ViewGraph;
 
 pub fn compute(graph: &ViewGraph) -> PriorValues {
     let values = (0..graph.num_vertices())

@@ -13,16 +13,17 @@
 //! such images down-weighted as in TF-IDF, the distinct surroundings remain).
 
 use super::overlap::convex_hull;
-use super::{Inputs, PriorValues};
+use super::PriorValues;
+use crate::scene::Scene;
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeMap, HashSet};
 
 /// Each vertex's matched keypoints with the vertices they match, sorted by keypoint.
-fn matched_features(inputs: &Inputs) -> Vec<Vec<(u32, u32)>> {
-    let n = inputs.graph.num_vertices();
+fn matched_features(scene: &Scene) -> Vec<Vec<(u32, u32)>> {
+    let n = scene.graph.num_vertices();
     let mut out: Vec<Vec<(u32, u32)>> = vec![Vec::new(); n];
-    for (edge, e) in inputs.graph.edges.iter().enumerate() {
-        for [a, b] in inputs.edge_inliers(edge) {
+    for (edge, e) in scene.graph.edges.iter().enumerate() {
+        for [a, b] in scene.edge_inliers(edge) {
             out[e.i as usize].push((a, e.j));
             out[e.j as usize].push((b, e.i));
         }
@@ -31,7 +32,8 @@ fn matched_features(inputs: &Inputs) -> Vec<Vec<(u32, u32)>> {
     out
 }
 
-type Context = HashMap<u32, f64>;
+/// Ordered, so that sums over it run in one order and the prior is the same bit for bit on every run.
+type Context = BTreeMap<u32, f64>;
 
 /// w of vertex `v` in its pair with `other`: features of `v` not in `matched`, kept by `keep`.
 fn context_vector(
@@ -76,31 +78,31 @@ fn inside(hull: &[[f32; 2]], p: [f32; 2]) -> bool {
     })
 }
 
-pub fn compute(inputs: &Inputs) -> Vec<PriorValues> {
-    let features = matched_features(inputs);
-    let n = inputs.graph.num_vertices() as f64;
+pub fn compute(scene: &Scene) -> Vec<PriorValues> {
+    let features = matched_features(scene);
+    let n = scene.graph.num_vertices() as f64;
     let idf = |k: u32| {
-        (n / (1.0 + inputs.graph.degree(k as usize) as f64))
+        (n / (1.0 + scene.graph.degree(k as usize) as f64))
             .ln()
             .max(0.0)
     };
-    let rows: Vec<[f64; 3]> = (0..inputs.graph.edges.len())
+    let rows: Vec<[f64; 3]> = (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
-            let e = &inputs.graph.edges[edge];
+            let e = &scene.graph.edges[edge];
             let (i, j) = (e.i as usize, e.j as usize);
             let (mi, mj): (HashSet<u32>, HashSet<u32>) =
-                inputs.edge_inliers(edge).map(|[a, b]| (a, b)).unzip();
+                scene.edge_inliers(edge).map(|[a, b]| (a, b)).unzip();
             let all = |_: u32| true;
             let one = |_: u32| 1.0;
             let wi = context_vector(&features[i], e.j, &mi, &all, &one);
             let wj = context_vector(&features[j], e.i, &mj, &all, &one);
             let hull = |v: usize, m: &HashSet<u32>| {
-                convex_hull(m.iter().map(|&k| inputs.keypoints[v][k as usize]).collect())
+                convex_hull(m.iter().map(|&k| scene.keypoints[v][k as usize]).collect())
             };
             let (hi, hj) = (hull(i, &mi), hull(j, &mj));
-            let out_i = |kp: u32| !inside(&hi, inputs.keypoints[i][kp as usize]);
-            let out_j = |kp: u32| !inside(&hj, inputs.keypoints[j][kp as usize]);
+            let out_i = |kp: u32| !inside(&hi, scene.keypoints[i][kp as usize]);
+            let out_j = |kp: u32| !inside(&hj, scene.keypoints[j][kp as usize]);
             let oi = context_vector(&features[i], e.j, &mi, &out_i, &idf);
             let oj = context_vector(&features[j], e.i, &mj, &out_j, &idf);
             [cosine(&wi, &wj), hamming(&wi, &wj), cosine(&oi, &oj)]
@@ -119,27 +121,17 @@ pub fn compute(inputs: &Inputs) -> Vec<PriorValues> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::database::{Image, VerifiedPair};
-    use crate::view_graph::ViewGraph;
+    use crate::colmap::database::{Image, VerifiedPair};
+    use crate::scene::testing::{images, pair};
+    use crate::scene::view_graph::ViewGraph;
 
     /// Images 1, 2 see copy A with surroundings seen by image 3; image 4 sees copy B with
     /// surroundings seen by image 5. Pair (1, 2) is true, pair (1, 4) false: the copies match
     /// on keypoints 0..20 (pair (1, 4) only on 0..10, whose hull holds 10..20), the
     /// surroundings are keypoints 20..40.
-    fn scene() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
-        let images = (1..=5)
-            .map(|id| Image {
-                image_id: id,
-                name: format!("{id}"),
-                camera_id: 1,
-            })
-            .collect::<Vec<_>>();
-        let pair = |a, b, range: std::ops::Range<u32>| VerifiedPair {
-            image_id1: a,
-            image_id2: b,
-            config: 2,
-            inliers: range.map(|k| [k, k]).collect(),
-        };
+    fn two_copies() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
+        let images = images(5);
+        let pair = |a, b, range: std::ops::Range<u32>| pair(a, b, range.map(|k| [k, k]).collect());
         let pairs = vec![
             pair(1, 2, 0..20),
             pair(1, 3, 20..40),
@@ -165,15 +157,10 @@ mod tests {
 
     #[test]
     fn true_pair_shares_context_false_pair_does_not() {
-        let (images, pairs, keypoints) = scene();
+        let (images, pairs, keypoints) = two_copies();
         let graph = ViewGraph::build(&images, &pairs, 1);
-        let inputs = Inputs {
-            graph: &graph,
-            pairs: &pairs,
-            keypoints,
-            image_sizes: vec![(640, 480); 5],
-        };
-        let values = compute(&inputs);
+        let scene = Scene::new(&graph, &pairs, keypoints, vec![(640, 480); 5]);
+        let values = compute(&scene);
         let at = |name: &str, a: u32, b: u32| {
             let edge = graph
                 .edges

@@ -1,7 +1,7 @@
 //! Image prior: degree in the view graph. Well-connected images support long tracks.
 
 use super::PriorValues;
-use crate::view_graph::ViewGraph;
+use crate::scene::view_graph::ViewGraph;
 
 pub fn compute(graph: &ViewGraph) -> PriorValues {
     let values = (0..graph.num_vertices())

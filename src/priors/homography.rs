@@ -8,9 +8,10 @@
 //! RANSAC fit of our own took 80% of a 100K-pair prune. Pairs the database stores no homography
 //! for get one fitted (RANSAC) to their normalised inliers.
 
-use super::{Inputs, PriorValues};
-use crate::geometry::{estimate_homography, homography_inliers};
-use crate::view_geometry::ViewGeometry;
+use super::PriorValues;
+use crate::geometry::pose::{estimate_homography, homography_inliers};
+use crate::geometry::view_geometry::ViewGeometry;
+use crate::scene::Scene;
 use anyhow::Result;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -28,12 +29,12 @@ pub fn score(h: &Matrix3<f64>) -> f64 {
     (h.transpose() * h - Matrix3::identity()).norm().min(2.0)
 }
 
-pub fn compute(inputs: &Inputs, geometry: &ViewGeometry) -> Result<PriorValues> {
-    let values = (0..inputs.graph.edges.len())
+pub fn compute(scene: &Scene, geometry: &ViewGeometry) -> Result<PriorValues> {
+    let values = (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
-            let (x1, x2) = geometry.edge_points(inputs, edge);
-            let threshold = geometry.threshold(inputs, edge);
+            let (x1, x2) = geometry.edge_points(scene, edge);
+            let threshold = geometry.threshold(scene, edge);
             let fitted = match geometry.homographies[edge] {
                 Some(h) => Some((h, homography_inliers(&h, &x1, &x2, threshold))),
                 None => estimate_homography(&x1, &x2, threshold)?,

@@ -1,13 +1,14 @@
 //! Pair prior: number of verified inlier correspondences.
 
-use super::{Inputs, PriorValues};
+use super::PriorValues;
+use crate::scene::Scene;
 
-pub fn compute(inputs: &Inputs) -> PriorValues {
-    let values = inputs
+pub fn compute(scene: &Scene) -> PriorValues {
+    let values = scene
         .graph
         .edges
         .iter()
-        .map(|e| inputs.pairs[e.pair].inliers.len() as f64)
+        .map(|e| scene.pairs[e.pair].inliers.len() as f64)
         .collect();
     PriorValues {
         name: "inliers",

@@ -8,8 +8,9 @@
 //! centres always are): rotation chaining cannot see a copy that is only translated, and a raw
 //! count favours pairs in dense regions whatever their truth.
 
-use super::{Inputs, PriorValues};
-use crate::geometry::{rotation_angle_deg, RelativePose};
+use super::PriorValues;
+use crate::geometry::pose::{rotation_angle_deg, RelativePose};
+use crate::scene::Scene;
 use nalgebra::Rotation3;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -38,8 +39,8 @@ pub fn triangle_errors(ab: &RelativePose, bc: &RelativePose, ac: &RelativePose) 
     (rotation_angle_deg(&chained), coplanar)
 }
 
-pub fn compute(inputs: &Inputs, poses: &[Option<RelativePose>]) -> Vec<PriorValues> {
-    let graph = inputs.graph;
+pub fn compute(scene: &Scene, poses: &[Option<RelativePose>]) -> Vec<PriorValues> {
+    let graph = scene.graph;
     let index: HashMap<(u32, u32), usize> = graph
         .edges
         .iter()
@@ -113,7 +114,7 @@ pub fn compute(inputs: &Inputs, poses: &[Option<RelativePose>]) -> Vec<PriorValu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::PoseSource;
+    use crate::geometry::pose::PoseSource;
     use nalgebra::{Unit, Vector3};
 
     /// Pose a -> b of two world-to-camera poses.

@@ -4,9 +4,10 @@
 //! is the angle of R1ᵀR2, `motion_position` the angle between the translation directions
 //! (degrees); both are NaN (left out of the cost) where no second motion is found.
 
-use super::{Inputs, PriorValues};
-use crate::geometry::{direction_angle_deg, estimate_pose, rotation_angle_deg, RelativePose};
-use crate::view_geometry::ViewGeometry;
+use super::PriorValues;
+use crate::geometry::pose::{direction_angle_deg, estimate_pose, rotation_angle_deg, RelativePose};
+use crate::geometry::view_geometry::ViewGeometry;
+use crate::scene::Scene;
 use anyhow::Result;
 use rayon::prelude::*;
 use std::collections::HashSet;
@@ -28,19 +29,19 @@ pub fn motion_difference(a: &RelativePose, b: &RelativePose) -> (f64, f64) {
 
 /// `matches[edge]` are the raw matches of each edge, oriented i -> j.
 pub fn compute(
-    inputs: &Inputs,
+    scene: &Scene,
     geometry: &ViewGeometry,
     matches: &[Vec<[u32; 2]>],
 ) -> Result<Vec<PriorValues>> {
-    let rows = (0..inputs.graph.edges.len())
+    let rows = (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| -> Result<(f64, f64)> {
             let absent = (f64::NAN, f64::NAN);
             let Some(primary) = &geometry.poses[edge] else {
                 return Ok(absent);
             };
-            let e = &inputs.graph.edges[edge];
-            let inliers: HashSet<[u32; 2]> = inputs.edge_inliers(edge).collect();
+            let e = &scene.graph.edges[edge];
+            let inliers: HashSet<[u32; 2]> = scene.edge_inliers(edge).collect();
             let (x1, x2): (Vec<[f64; 2]>, Vec<[f64; 2]>) = matches[edge]
                 .iter()
                 .filter(|m| !inliers.contains(*m))
@@ -55,12 +56,7 @@ pub fn compute(
                 return Ok(absent);
             }
             Ok(
-                match estimate_pose(
-                    &x1,
-                    &x2,
-                    geometry.threshold(inputs, edge),
-                    SECOND_ITERATIONS,
-                )? {
+                match estimate_pose(&x1, &x2, geometry.threshold(scene, edge), SECOND_ITERATIONS)? {
                     Some((second, _)) if second.support >= MIN_SECOND_INLIERS => {
                         motion_difference(primary, &second)
                     }
@@ -84,7 +80,7 @@ pub fn compute(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tests::two_view;
+    use crate::geometry::pose::tests::two_view;
     use nalgebra::{Rotation3, Vector3};
 
     #[test]

@@ -2,21 +2,22 @@
 //! inlier keypoints divided by the image area. Pairs whose matches cover little of the images
 //! constrain the geometry poorly.
 
-use super::{Inputs, PriorValues};
+use super::PriorValues;
+use crate::scene::Scene;
 use rayon::prelude::*;
 
-pub fn compute(inputs: &Inputs) -> PriorValues {
-    let values = (0..inputs.graph.edges.len())
+pub fn compute(scene: &Scene) -> PriorValues {
+    let values = (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
-            let e = &inputs.graph.edges[edge];
+            let e = &scene.graph.edges[edge];
             let (mut pi, mut pj) = (Vec::new(), Vec::new());
-            for [a, b] in inputs.edge_inliers(edge) {
-                pi.push(inputs.keypoints[e.i as usize][a as usize]);
-                pj.push(inputs.keypoints[e.j as usize][b as usize]);
+            for [a, b] in scene.edge_inliers(edge) {
+                pi.push(scene.keypoints[e.i as usize][a as usize]);
+                pj.push(scene.keypoints[e.j as usize][b as usize]);
             }
             let ratio = |points: Vec<[f32; 2]>, v: u32| {
-                let (w, h) = inputs.image_sizes[v as usize];
+                let (w, h) = scene.image_sizes[v as usize];
                 (convex_hull_area(points) / (w as f64 * h as f64)).min(1.0)
             };
             0.5 * (ratio(pi, e.i) + ratio(pj, e.j))

@@ -1,13 +1,13 @@
 //! Computes the pair priors a cost model names, and only those: the pose-based ones need the
 //! cameras, focal-length estimation and a relative pose per pair; multiple motions also need the
-//! raw matches.
+//! raw matches. [`needs`] tells the pipeline which of those to load into the [`Scene`].
 
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
-use super::{triangulation_angle, unique_tracks, Inputs, PriorValues};
-use crate::camera::CameraModel;
-use crate::database::Database;
-use crate::focal::{self, FundamentalPair};
-use crate::view_geometry::{self, ViewGeometry};
+use super::{triangulation_angle, unique_tracks, PriorValues};
+use crate::geometry::camera::CameraModel;
+use crate::geometry::focal::{self, FundamentalPair};
+use crate::geometry::view_geometry::{self, ViewGeometry};
+use crate::scene::Scene;
 use anyhow::{Context, Result};
 use nalgebra::Matrix3;
 use serde::Serialize;
@@ -35,60 +35,61 @@ const POSE_PRIORS: [&str; 6] = [
     "motion_position",
 ];
 
-/// `camera_ids[v]` is the camera of vertex v. `stage` is told each long step.
-pub fn compute(
-    db: &Database,
-    inputs: &Inputs,
-    camera_ids: &[u32],
-    names: &[&str],
-    stage: &dyn Fn(&str),
-) -> Result<PairPriors> {
+/// What of the database the priors `names` read beyond the view graph and keypoints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Needs {
+    /// Cameras and stored two-view geometries (the pose-based priors).
+    pub geometry: bool,
+    /// Raw matches (multiple motions).
+    pub matches: bool,
+}
+
+/// What computing the priors `names` needs loaded.
+pub fn needs(names: &[&str]) -> Needs {
+    let motion = names.contains(&"motion_rotation") || names.contains(&"motion_position");
+    Needs {
+        geometry: POSE_PRIORS.iter().any(|n| names.contains(n)),
+        matches: motion,
+    }
+}
+
+/// Computes the priors `names` on `scene`, which holds what [`needs`] asked for. `stage` is
+/// told each long step.
+pub fn compute(scene: &Scene, names: &[&str], stage: &dyn Fn(&str)) -> Result<PairPriors> {
     let wants = |n: &str| names.contains(&n);
     let mut values = Vec::new();
     if wants("inliers") {
-        values.push(inliers::compute(inputs));
+        values.push(inliers::compute(scene));
     }
     if wants("overlap") {
-        values.push(overlap::compute(inputs));
+        values.push(overlap::compute(scene));
     }
     if wants("unique_tracks") {
         stage("following tracks");
-        values.push(unique_tracks::compute(inputs));
+        values.push(unique_tracks::compute(scene));
     }
     if names.iter().any(|n| n.starts_with("context")) {
         stage("computing context similarity");
-        values.extend(context::compute(inputs));
+        values.extend(context::compute(scene));
     }
     let mut focal_estimates = Vec::new();
     if POSE_PRIORS.iter().any(|n| wants(n)) {
-        let (geometry, estimates) = relative_poses(db, inputs, camera_ids, stage)?;
+        let (geometry, estimates) = relative_poses(scene, stage)?;
         focal_estimates = estimates;
         if wants("triangulation_angle") {
-            values.push(triangulation_angle::compute(inputs, &geometry));
+            values.push(triangulation_angle::compute(scene, &geometry));
         }
         if wants("homography") {
             stage("scoring homographies");
-            values.push(homography::compute(inputs, &geometry)?);
+            values.push(homography::compute(scene, &geometry)?);
         }
         if wants("loop") || wants("loop_fraction") {
             stage("checking loop consistency");
-            values.extend(loop_consistency::compute(inputs, &geometry.poses));
+            values.extend(loop_consistency::compute(scene, &geometry.poses));
         }
         if wants("motion_rotation") || wants("motion_position") {
-            stage("reading raw matches");
-            let matches = inputs
-                .graph
-                .edges
-                .iter()
-                .map(|e| {
-                    db.matches(
-                        inputs.graph.image_ids[e.i as usize],
-                        inputs.graph.image_ids[e.j as usize],
-                    )
-                })
-                .collect::<Result<Vec<_>>>()?;
             stage("searching for multiple motions");
-            values.extend(multiple_motions::compute(inputs, &geometry, &matches)?);
+            values.extend(multiple_motions::compute(scene, &geometry, &scene.matches)?);
         }
     }
     Ok(PairPriors {
@@ -99,41 +100,21 @@ pub fn compute(
 
 /// Cameras (with focal lengths estimated where only guessed) and every edge's relative pose.
 fn relative_poses(
-    db: &Database,
-    inputs: &Inputs,
-    camera_ids: &[u32],
+    scene: &Scene,
     stage: &dyn Fn(&str),
 ) -> Result<(ViewGeometry, Vec<FocalEstimate>)> {
     let mut models: Vec<CameraModel> = Vec::new();
     let mut index: HashMap<u32, usize> = HashMap::new();
-    for c in db.cameras()? {
-        if camera_ids.contains(&c.camera_id) {
-            index.insert(c.camera_id, models.len());
-            models.push(CameraModel::from_colmap(&c)?);
-        }
+    for c in &scene.cameras {
+        index.insert(c.camera_id, models.len());
+        models.push(CameraModel::from_colmap(c)?);
     }
-    let camera_of = |v: usize| index[&camera_ids[v]];
-    let stored = db.geometries()?;
-    let by_pair: HashMap<(u32, u32), usize> = stored
-        .iter()
-        .enumerate()
-        .map(|(k, g)| ((g.image_id1, g.image_id2), k))
-        .collect();
-    let geometries: Vec<_> = inputs
-        .graph
-        .edges
-        .iter()
-        .map(|e| {
-            let p = &inputs.pairs[e.pair];
-            by_pair
-                .get(&(p.image_id1, p.image_id2))
-                .map(|&k| &stored[k])
-        })
-        .collect();
+    let camera_of = |v: usize| index[&scene.camera_ids[v]];
+    let geometries: Vec<_> = scene.geometries.iter().map(Option::as_ref).collect();
     let mut estimates = Vec::new();
     if models.iter().any(|m| !m.prior_focal_length) {
         stage("estimating focal lengths from the fundamental matrices");
-        let pairs: Vec<FundamentalPair> = inputs
+        let pairs: Vec<FundamentalPair> = scene
             .graph
             .edges
             .iter()
@@ -163,10 +144,10 @@ fn relative_poses(
         }
     }
     stage("recovering relative poses");
-    let cameras = (0..inputs.graph.num_vertices())
+    let cameras = (0..scene.graph.num_vertices())
         .map(|v| models[camera_of(v)].clone())
         .collect();
     let geometry =
-        view_geometry::compute(inputs, cameras, &geometries).context("computing relative poses")?;
+        view_geometry::compute(scene, cameras, &geometries).context("computing relative poses")?;
     Ok((geometry, estimates))
 }

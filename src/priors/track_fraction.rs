@@ -1,16 +1,17 @@
 //! Image prior: fraction of an image's keypoints that are inliers of at least one view-graph
 //! edge, i.e. that take part in a track. Images with many observations anchor the reconstruction.
 
-use super::{Inputs, PriorValues};
+use super::PriorValues;
+use crate::scene::Scene;
 
-pub fn compute(inputs: &Inputs) -> PriorValues {
-    let mut in_track: Vec<Vec<bool>> = inputs
+pub fn compute(scene: &Scene) -> PriorValues {
+    let mut in_track: Vec<Vec<bool>> = scene
         .keypoints
         .iter()
         .map(|k| vec![false; k.len()])
         .collect();
-    for (edge, e) in inputs.graph.edges.iter().enumerate() {
-        for [a, b] in inputs.edge_inliers(edge) {
+    for (edge, e) in scene.graph.edges.iter().enumerate() {
+        for [a, b] in scene.edge_inliers(edge) {
             in_track[e.i as usize][a as usize] = true;
             in_track[e.j as usize][b as usize] = true;
         }
@@ -31,41 +32,22 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::database::{Image, VerifiedPair};
-    use crate::view_graph::ViewGraph;
+    use crate::scene::testing::{images, pair};
+    use crate::scene::view_graph::ViewGraph;
 
     #[test]
     fn counts_each_keypoint_once_across_pairs() {
-        let images: Vec<Image> = (1..=3)
-            .map(|id| Image {
-                image_id: id,
-                name: id.to_string(),
-                camera_id: 1,
-            })
-            .collect();
+        let images = images(3);
         // Pair ids are stored with the larger image first here to exercise orientation.
-        let pairs = vec![
-            VerifiedPair {
-                image_id1: 1,
-                image_id2: 2,
-                config: 2,
-                inliers: vec![[0, 1], [1, 2]],
-            },
-            VerifiedPair {
-                image_id1: 1,
-                image_id2: 3,
-                config: 2,
-                inliers: vec![[0, 3]],
-            },
-        ];
+        let pairs = vec![pair(1, 2, vec![[0, 1], [1, 2]]), pair(1, 3, vec![[0, 3]])];
         let graph = ViewGraph::build(&images, &pairs, 1);
-        let inputs = Inputs {
-            graph: &graph,
-            pairs: &pairs,
-            keypoints: vec![vec![[0.0; 2]; 4], vec![[0.0; 2]; 3], vec![[0.0; 2]; 8]],
-            image_sizes: vec![(10, 10); 3],
-        };
-        let v = compute(&inputs).values;
+        let scene = Scene::new(
+            &graph,
+            &pairs,
+            vec![vec![[0.0; 2]; 4], vec![[0.0; 2]; 3], vec![[0.0; 2]; 8]],
+            vec![(10, 10); 3],
+        );
+        let v = compute(&scene).values;
         assert_eq!(v, vec![2.0 / 4.0, 2.0 / 3.0, 1.0 / 8.0]);
     }
 }

@@ -3,19 +3,20 @@
 //! 45°, stays high to 90° and falls to 120°. Pairs without a pose, or whose points all fail
 //! triangulation, get 0.
 
-use super::{Inputs, PriorValues};
-use crate::geometry::{direction_angle_deg, triangulate};
-use crate::view_geometry::ViewGeometry;
+use super::PriorValues;
+use crate::geometry::pose::{direction_angle_deg, triangulate};
+use crate::geometry::view_geometry::ViewGeometry;
+use crate::scene::Scene;
 use rayon::prelude::*;
 
-pub fn compute(inputs: &Inputs, geometry: &ViewGeometry) -> PriorValues {
-    let values = (0..inputs.graph.edges.len())
+pub fn compute(scene: &Scene, geometry: &ViewGeometry) -> PriorValues {
+    let values = (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
             let Some(pose) = &geometry.poses[edge] else {
                 return 0.0;
             };
-            let (x1, x2) = geometry.edge_points(inputs, edge);
+            let (x1, x2) = geometry.edge_points(scene, edge);
             let t = pose.translation.into_inner();
             let c2 = pose.centre2();
             let mut angles: Vec<f64> = x1
@@ -45,8 +46,8 @@ pub fn median(values: &mut [f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::tests::two_view;
-    use crate::geometry::{PoseSource, RelativePose};
+    use crate::geometry::pose::tests::two_view;
+    use crate::geometry::pose::{PoseSource, RelativePose};
     use nalgebra::{Rotation3, Unit, Vector3};
 
     #[test]

@@ -10,18 +10,19 @@
 //! follows how densely the scene was photographed). Measured on the rendered duplicate scenes
 //! (docs/priors.md): factor 4 separates better than 2 or 3 and as well as a smooth 1/length.
 
-use super::{Inputs, PriorValues};
+use super::PriorValues;
+use crate::scene::Scene;
 use petgraph::unionfind::UnionFind;
 
 /// A track with more observations than this many times the median is confusing.
 pub const CONFUSING_FACTOR: u32 = 4;
 
-pub fn compute(inputs: &Inputs) -> PriorValues {
-    let graph = inputs.graph;
+pub fn compute(scene: &Scene) -> PriorValues {
+    let graph = scene.graph;
     // One union-find element per keypoint of every vertex.
-    let mut offset = Vec::with_capacity(inputs.keypoints.len() + 1);
+    let mut offset = Vec::with_capacity(scene.keypoints.len() + 1);
     offset.push(0usize);
-    for k in &inputs.keypoints {
+    for k in &scene.keypoints {
         offset.push(offset.last().unwrap() + k.len());
     }
     let element = |v: u32, kp: u32| offset[v as usize] + kp as usize;
@@ -30,7 +31,7 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
     // Observations per track are its matched keypoints (one per image on a consistent track).
     let mut matched = vec![false; keypoints];
     for (edge, e) in graph.edges.iter().enumerate() {
-        for [a, b] in inputs.edge_inliers(edge) {
+        for [a, b] in scene.edge_inliers(edge) {
             let (x, y) = (element(e.i, a), element(e.j, b));
             tracks.union(x, y);
             matched[x] = true;
@@ -55,7 +56,7 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
         .enumerate()
         .map(|(edge, e)| {
             let (mut unique, mut all) = (0usize, 0usize);
-            for [a, _] in inputs.edge_inliers(edge) {
+            for [a, _] in scene.edge_inliers(edge) {
                 all += 1;
                 unique += (length[track[element(e.i, a)]] <= limit) as usize;
             }
@@ -75,17 +76,8 @@ pub fn compute(inputs: &Inputs) -> PriorValues {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::database::{Image, VerifiedPair};
-    use crate::view_graph::ViewGraph;
-
-    fn pair(a: u32, b: u32, inliers: Vec<[u32; 2]>) -> VerifiedPair {
-        VerifiedPair {
-            image_id1: a,
-            image_id2: b,
-            config: 2,
-            inliers,
-        }
-    }
+    use crate::scene::testing::{images, pair};
+    use crate::scene::view_graph::ViewGraph;
 
     #[test]
     fn inliers_on_a_track_seen_everywhere_are_confusing() {
@@ -93,13 +85,7 @@ mod tests {
         // keypoint 0 of every image is matched to keypoint 0 of every other image: one track
         // seen by all 12 images, 6 times the median (2).
         let n = 12;
-        let images: Vec<Image> = (1..=n)
-            .map(|id| Image {
-                image_id: id,
-                name: id.to_string(),
-                camera_id: 1,
-            })
-            .collect();
+        let images = images(n);
         let mut pairs = Vec::new();
         for a in 1..=n {
             for b in a + 1..=n {
@@ -112,13 +98,13 @@ mod tests {
             }
         }
         let graph = ViewGraph::build(&images, &pairs, 1);
-        let inputs = Inputs {
-            graph: &graph,
-            pairs: &pairs,
-            keypoints: vec![vec![[0.0, 0.0]; 5]; n as usize],
-            image_sizes: vec![(100, 100); n as usize],
-        };
-        let v = compute(&inputs);
+        let scene = Scene::new(
+            &graph,
+            &pairs,
+            vec![vec![[0.0, 0.0]; 5]; n as usize],
+            vec![(100, 100); n as usize],
+        );
+        let v = compute(&scene);
         for (e, value) in graph.edges.iter().zip(&v.values) {
             let expected = if e.j == e.i + 1 { 2.0 / 3.0 } else { 0.0 };
             assert!((value - expected).abs() < 1e-12, "{e:?}: {value}");

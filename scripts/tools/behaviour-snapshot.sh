@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Everything a user can observe of a vgsel-colmap binary on one database, written to a folder so
+# that two binaries (before and after a refactoring) compare with `diff -r`: every --help text,
+# completions, the man page, and for both presets the report JSON (timings and clocks removed),
+# the --scores CSV, the pair list, the plots, the pruned database's SQL dump (run times removed),
+# inspect, both exports and the restored dump.
+# usage: scripts/tools/behaviour-snapshot.sh BINARY DATABASE OUTDIR
+set -euo pipefail
+[ $# -eq 3 ] || { echo "usage: $0 BINARY DATABASE OUTDIR" >&2; exit 2; }
+bin=$(realpath "$1")
+db=$(realpath "$2")
+rm -rf "$3"
+mkdir -p "$3"
+out=$(realpath "$3")
+cd "$out"
+
+# JSON without the keys whose values are clocks.
+strip_times() {
+  python3 -c '
+import json, sys
+def clean(v):
+    if isinstance(v, dict):
+        return {k: clean(x) for k, x in v.items() if k not in ("timings", "time")}
+    if isinstance(v, list):
+        return [clean(x) for x in v]
+    return v
+print(json.dumps(clean(json.load(sys.stdin)), indent=1, sort_keys=True))'
+}
+dump() { sqlite3 "$1" .dump | sed -E "s/'[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+Z'/'TIME'/g"; }
+
+"$bin" --help >help.txt
+for sub in prune restore inspect solve eval export completions man; do
+  "$bin" "$sub" --help >"help-$sub.txt"
+done
+for sub in images database graph; do
+  "$bin" generate "$sub" --help >"help-generate-$sub.txt"
+done
+"$bin" completions bash >completions.bash
+"$bin" man >man.1
+
+for preset in general disambiguation; do
+  mkdir "$preset"
+  cp "$db" "$preset/in.db"
+  "$bin" -q prune --database_path "$preset/in.db" --preset "$preset" --dry_run \
+    --report "$preset/dry.json" --scores "$preset/scores.csv" --pairs_out "$preset/pairs.txt" \
+    --plots "$preset/plots"
+  "$bin" -q prune --database_path "$preset/in.db" --preset "$preset" --output "$preset/pruned.db" \
+    --report "$preset/report.json"
+  for f in dry report; do strip_times <"$preset/$f.json" >"$preset/$f.clean.json"; rm "$preset/$f.json"; done
+  dump "$preset/pruned.db" >"$preset/pruned.sql"
+  "$bin" inspect --database_path "$preset/pruned.db" --json >"$preset/inspect.json"
+  "$bin" -q export --database_path "$preset/pruned.db" --format dot --output "$preset/graph.dot"
+  "$bin" -q export --database_path "$preset/pruned.db" --format graphml --output "$preset/graph.graphml"
+  "$bin" -q restore --database_path "$preset/pruned.db"
+  dump "$preset/pruned.db" >"$preset/restored.sql"
+  rm -f "$preset"/in.db* "$preset"/pruned.db*
+done
+dump "$db" >original.sql
+cmp -s original.sql general/restored.sql && cmp -s original.sql disambiguation/restored.sql \
+  && echo "restore exact" >restore.txt

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Runs scripts/pipeline.sh on the real image sets in ../shared/datasets (never copied into the
+# project) and prints a markdown results table; one set at a time, as COLMAP uses both cores.
+# usage: scripts/tools/run-datasets.sh [SET ...]   (default: the small sets; WORK=target/datasets)
+# environment: DATASETS (default ../shared/datasets), WORK, and everything pipeline.sh reads.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/../.." && pwd)
+datasets=${DATASETS:-$here/../shared/datasets}
+work=${WORK:-$here/target/datasets}
+sets=("$@")
+[ ${#sets[@]} -gt 0 ] || sets=(strecha_fountain-P11 lund_door yan2017_street_gifframes
+  yan2017_books_gifframes yan2017_oats_gifframes yan2017_cereal_gifframes)
+for set in "${sets[@]}"; do
+  gt=$datasets/$set/gt/colmap_text
+  [ -f "$gt/images.txt" ] || gt=
+  echo "== $set" >&2
+  bash "$here/scripts/pipeline.sh" "$datasets/$set/images" "$work/$set" $gt >&2 ||
+    echo "run-datasets: $set failed (see $work/$set)" >&2
+done
+python3 "$here/scripts/tools/results-table.py" "$work" "${sets[@]}"
+# Sets without ground truth: the written-down ghost check on the camera paths (scripts/tools/topview.py).
+for set in "${sets[@]}"; do
+  [ -f "$datasets/$set/gt/colmap_text/images.txt" ] || [ ! -f "$work/$set/summary.json" ] && continue
+  python3 "$here/scripts/tools/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"
+done

@@ -1,0 +1,7 @@
+//! Everything that knows COLMAP's files: the SQLite database (read, rewrite, restore, copy) and
+//! sparse models. The rest of the crate sees COLMAP only through these types.
+
+pub mod database;
+pub mod ids;
+pub mod model;
+pub mod rewrite;

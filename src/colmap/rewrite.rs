@@ -1,0 +1,360 @@
+//! Invalidating unselected pairs in two_view_geometries, reversibly, in one transaction.
+//!
+//! An invalidated pair keeps its row with rows=0, cols=2, data=NULL, config=1 (DEGENERATE) and
+//! every geometry column NULL: COLMAP's incremental mapper skips rows=0, GLOMAP/global_mapper skip
+//! DEGENERATE, and a re-run matcher does not re-verify a pair whose row still exists. `matches`,
+//! `PRAGMA user_version` and COLMAP's table definitions are never touched. The original rows go to
+//! `vgsel_backup` (sql/vgsel.sql), whose untyped columns keep each value's storage class, so a
+//! restore is byte for byte.
+
+use crate::colmap::database::{sql_error, table_exists, Database, SqlResult, TWO_VIEW_COLUMNS};
+use crate::colmap::ids::{image_ids, TwoViewConfig};
+use anyhow::{anyhow, bail, Result};
+use rusqlite::{Connection, OpenFlags, Transaction, TransactionBehavior};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// The project's tables (CREATE TABLE IF NOT EXISTS).
+pub const VGSEL_SQL: &str = include_str!("../../sql/vgsel.sql");
+
+/// What a prune records in the project's runs table: its parameters `P` (stored as JSON with
+/// sorted keys; this layer does not know what they mean) and what it selected.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunRecord<P> {
+    /// The parameters the prune ran with.
+    pub parameters: P,
+    /// The flow F chosen (None where no flow ran).
+    pub flow: Option<u64>,
+    /// Images in the database.
+    pub images_total: usize,
+    /// Images with a selected pair.
+    pub images_selected: usize,
+    /// View-graph edges.
+    pub pairs_total: usize,
+    /// Edges left valid.
+    pub pairs_selected: usize,
+}
+
+/// A row of vgsel_runs, as read back.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunRecordRow<P> {
+    /// The row's id: 1 for the first prune, counting up.
+    pub run_id: i64,
+    /// UTC, ISO-8601 (`2024-05-01T12:00:00Z`).
+    pub time: String,
+    /// The vgsel-colmap version that pruned.
+    pub tool_version: String,
+    /// What it recorded.
+    pub run: RunRecord<P>,
+}
+
+/// Puts every backed-up row back into two_view_geometries (re-inserting rows deleted since the
+/// prune) and returns how many. Copies values column to column inside SQLite, so storage
+/// classes survive. Leaves the backup table as it is.
+fn put_back(conn: &Connection, columns: &[&str]) -> rusqlite::Result<usize> {
+    let set: Vec<String> = columns.iter().map(|c| format!("{c} = b.{c}")).collect();
+    conn.execute(
+        &format!(
+            "UPDATE two_view_geometries SET {} FROM vgsel_backup AS b \
+             WHERE two_view_geometries.pair_id = b.pair_id",
+            set.join(", ")
+        ),
+        [],
+    )?;
+    let list = columns.join(", ");
+    conn.execute(
+        &format!(
+            "INSERT INTO two_view_geometries (pair_id, {list}) SELECT pair_id, {list} \
+             FROM vgsel_backup WHERE pair_id NOT IN (SELECT pair_id FROM two_view_geometries)"
+        ),
+        [],
+    )?;
+    conn.query_row("SELECT count(*) FROM vgsel_backup", [], |r| {
+        r.get::<_, i64>(0)
+    })
+    .map(|n| n as usize)
+}
+
+fn ensure_writable(db: &Database) -> Result<()> {
+    if db.is_read_only() {
+        bail!(
+            "{}: database was opened read-only; cannot rewrite it",
+            db.path().display()
+        );
+    }
+    Ok(())
+}
+
+/// Makes exactly the pairs in `invalidate` (pair_ids) invalid, starting from the original rows
+/// (a previous prune is undone first), saves their original rows in the backup table and appends
+/// a run record; all in one transaction.
+pub fn apply<P: Serialize>(
+    db: &mut Database,
+    invalidate: &[u64],
+    run: &RunRecord<P>,
+) -> Result<()> {
+    // Through a JSON value, whose maps are sorted: the stored text does not depend on field order.
+    let parameters = serde_json::to_value(&run.parameters)?.to_string();
+    write_transaction(db, |tx, columns, p| {
+        apply_in(tx, columns, p, invalidate, &parameters, run)
+    })
+}
+
+/// Runs `body` in one IMMEDIATE transaction of a writable database and commits it; on failure
+/// the transaction rolls back and the journal is settled. `body` gets the layout's
+/// two_view_geometries columns and the path for error messages.
+fn write_transaction<T>(
+    db: &mut Database,
+    body: impl FnOnce(&Transaction, &[&'static str], &Path) -> Result<T>,
+) -> Result<T> {
+    ensure_writable(db)?;
+    let path = db.path().to_path_buf();
+    let columns = db.layout().two_view_columns.clone();
+    let result = (|| {
+        let tx = db
+            .conn_mut()
+            .transaction_with_behavior(TransactionBehavior::Immediate)
+            .sql(&path)?;
+        let out = body(&tx, &columns, &path)?;
+        tx.commit().sql(&path)?;
+        Ok(out)
+    })();
+    if result.is_err() {
+        settle_after_failure(db);
+    }
+    result
+}
+
+/// After a write fails (disk full, I/O error) SQLite can leave the rolled-back transaction's hot
+/// journal beside the database until the next statement. One read plays it back now, so a failed
+/// command leaves no `-journal` file behind; if that read fails too, the next open does it.
+fn settle_after_failure(db: &Database) {
+    let _ = db
+        .conn()
+        .query_row("SELECT count(*) FROM sqlite_master", [], |r| {
+            r.get::<_, i64>(0)
+        });
+}
+
+fn apply_in<P>(
+    tx: &Transaction,
+    columns: &[&'static str],
+    p: &Path,
+    invalidate: &[u64],
+    parameters: &str,
+    run: &RunRecord<P>,
+) -> Result<()> {
+    tx.execute_batch(VGSEL_SQL).sql(p)?;
+    put_back(tx, columns).sql(p)?;
+    tx.execute("DELETE FROM vgsel_backup", []).sql(p)?;
+
+    let copied: Vec<&str> = TWO_VIEW_COLUMNS
+        .iter()
+        .map(|c| if columns.contains(c) { *c } else { "NULL" })
+        .collect();
+    let mut backup = tx
+        .prepare(&format!(
+            "INSERT INTO vgsel_backup (pair_id, {}) SELECT pair_id, {} \
+             FROM two_view_geometries WHERE pair_id = ?1",
+            TWO_VIEW_COLUMNS.join(", "),
+            copied.join(", ")
+        ))
+        .sql(p)?;
+    let cleared: Vec<String> = columns
+        .iter()
+        .map(|c| match *c {
+            "rows" => "rows = 0".to_string(),
+            "cols" => "cols = 2".to_string(),
+            "config" => format!("config = {}", TwoViewConfig::Degenerate.code()),
+            other => format!("{other} = NULL"),
+        })
+        .collect();
+    let mut clear = tx
+        .prepare(&format!(
+            "UPDATE two_view_geometries SET {} WHERE pair_id = ?1",
+            cleared.join(", ")
+        ))
+        .sql(p)?;
+    let unique: BTreeSet<u64> = invalidate.iter().copied().collect();
+    for &id in &unique {
+        let (a, b) = image_ids(id);
+        let raw = i64::try_from(id).map_err(|_| anyhow!("pair_id {id} out of range"))?;
+        if backup.execute([raw]).sql(p)? == 0 {
+            bail!("cannot invalidate pair_id {id} (images {a}, {b}): it has no two_view_geometries row");
+        }
+        clear.execute([raw]).sql(p)?;
+    }
+    drop(backup);
+    drop(clear);
+
+    let count = |n: usize| n as i64;
+    tx.execute(
+        "INSERT INTO vgsel_runs (time, tool_version, parameters, flow, images_total, \
+         images_selected, pairs_total, pairs_selected) \
+         VALUES (strftime('%Y-%m-%dT%H:%M:%SZ', 'now'), ?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+        rusqlite::params![
+            env!("CARGO_PKG_VERSION"),
+            parameters,
+            run.flow.map(|f| f as i64),
+            count(run.images_total),
+            count(run.images_selected),
+            count(run.pairs_total),
+            count(run.pairs_selected),
+        ],
+    )
+    .sql(p)?;
+    Ok(())
+}
+
+/// Puts every backed-up row back, byte for byte, and drops the project's tables. Returns the
+/// number of rows restored; fails if the database was never pruned.
+pub fn restore(db: &mut Database) -> Result<usize> {
+    if !db.has_backup_table()? {
+        bail!("database was not pruned by vgsel-colmap");
+    }
+    write_transaction(db, |tx, columns, p| {
+        let n = put_back(tx, columns).sql(p)?;
+        tx.execute_batch("DROP TABLE vgsel_backup; DROP TABLE IF EXISTS vgsel_runs;")
+            .sql(p)?;
+        Ok(n)
+    })
+}
+
+/// The most recent prune's record, or None when the database has no runs table (never pruned,
+/// or restored since).
+pub fn last_run<P: DeserializeOwned>(db: &Database) -> Result<Option<RunRecordRow<P>>> {
+    let p = db.path();
+    let conn = db.conn();
+    if !table_exists(conn, "vgsel_runs").sql(p)? {
+        return Ok(None);
+    }
+    let mut stmt = conn
+        .prepare(
+            "SELECT run_id, time, tool_version, parameters, flow, images_total, images_selected, \
+             pairs_total, pairs_selected FROM vgsel_runs ORDER BY run_id DESC LIMIT 1",
+        )
+        .sql(p)?;
+    let mut rows = stmt.query([]).sql(p)?;
+    let Some(r) = rows.next().sql(p)? else {
+        return Ok(None);
+    };
+    let n = |i: usize| -> Result<usize> { Ok(r.get::<_, i64>(i).sql(p)? as usize) };
+    let run_id: i64 = r.get(0).sql(p)?;
+    let text: String = r.get(3).sql(p)?;
+    let parameters = serde_json::from_str(&text).map_err(|e| {
+        anyhow!(
+            "{}: vgsel_runs row {run_id}: parameters this version cannot read ({e}); restore and prune again",
+            p.display()
+        )
+    })?;
+    Ok(Some(RunRecordRow {
+        run_id,
+        time: r.get(1).sql(p)?,
+        tool_version: r.get(2).sql(p)?,
+        run: RunRecord {
+            parameters,
+            flow: r.get::<_, Option<i64>>(4).sql(p)?.map(|f| f as u64),
+            images_total: n(5)?,
+            images_selected: n(6)?,
+            pairs_total: n(7)?,
+            pairs_selected: n(8)?,
+        },
+    }))
+}
+
+/// Copies a COLMAP database for `prune --output`: SQLite's online backup API into a temporary
+/// file beside `dst`, then a rename, so `dst` is never half-written and a concurrent writer to
+/// `src` cannot tear the copy. Refuses an existing `dst` unless `overwrite`; never modifies `src`.
+/// Removes temporary copies of `dst` (and their journals) that a killed vgsel-colmap left beside
+/// it: names `.NAME.vgsel-tmp-PID…` or `..NAME.vgsel-tmp-PID…` whose process no longer runs.
+/// A SIGKILL cannot be cleaned up after at the time, so the next run does it.
+pub fn remove_stale_temporaries(dst: &Path) {
+    let (Some(dir), Some(name)) = (dst.parent(), dst.file_name()) else {
+        return;
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let prefix = format!(".{}.vgsel-tmp-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = file
+            .strip_prefix(&prefix)
+            .or_else(|| file.strip_prefix(&format!(".{prefix}")))
+        else {
+            continue;
+        };
+        let pid: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        if !pid.is_empty() && !Path::new("/proc").join(&pid).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+pub fn copy_database(src: &Path, dst: &Path, overwrite: bool) -> Result<()> {
+    // Validates src as a COLMAP database (with the usual one-line errors) and opens it read-only.
+    let source = Database::open_read_only(src)?;
+    if dst.is_dir() {
+        bail!("cannot write {}: it is a directory", dst.display());
+    }
+    if dst.exists() {
+        let same = match (src.canonicalize(), dst.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        if same {
+            bail!(
+                "cannot copy {} onto itself; give a different output path",
+                src.display()
+            );
+        }
+        if !overwrite {
+            bail!(
+                "output {} already exists (refusing to overwrite it)",
+                dst.display()
+            );
+        }
+    }
+    let name = dst
+        .file_name()
+        .ok_or_else(|| anyhow!("output path {} has no file name", dst.display()))?;
+    let tmp = dst.with_file_name(format!(
+        ".{}.vgsel-tmp-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| -> Result<()> {
+        let _ = std::fs::remove_file(&tmp);
+        source
+            .conn()
+            .backup(rusqlite::DatabaseName::Main, &tmp, None)
+            .map_err(|e| anyhow!("cannot copy {} to {}: {e}", src.display(), dst.display()))?;
+        // Reopen to be sure the copy is a readable database before it takes dst's name.
+        Connection::open_with_flags(&tmp, OpenFlags::SQLITE_OPEN_READ_ONLY)
+            .and_then(|c| c.query_row("PRAGMA quick_check", [], |r| r.get::<_, String>(0)))
+            .map_err(|e| sql_error(&tmp, e))
+            .and_then(|s| {
+                if s == "ok" {
+                    Ok(())
+                } else {
+                    Err(anyhow!(
+                        "{}: copy failed its integrity check: {s}",
+                        tmp.display()
+                    ))
+                }
+            })?;
+        std::fs::rename(&tmp, dst)
+            .map_err(|e| anyhow!("cannot rename {} to {}: {e}", tmp.display(), dst.display()))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}

@@ -1,0 +1,112 @@
+//! Scoring a reconstruction against ground-truth poses: every sub-model is aligned to the truth by
+//! the similarity under which the most cameras are right in position and rotation
+//! ([`align::align_poses`]); an image is correct when its centre is within 5% of the
+//! truth's extent and its rotation within 5 degrees. A ghosted model (one copy's cameras
+//! registered onto the other) registers images that are not correct.
+
+use crate::colmap::model;
+use crate::eval::align;
+use anyhow::{ensure, Result};
+use serde::Serialize;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Position error limit, as a fraction of the ground truth's extent.
+pub const POSITION_TOLERANCE: f64 = 0.05;
+/// Rotation error limit in degrees.
+pub const ROTATION_TOLERANCE_DEG: f64 = 5.0;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ImageScore {
+    pub name: String,
+    /// Index of the sub-model the image was scored in.
+    pub model: usize,
+    /// Centre error divided by the ground truth's extent.
+    pub position_error: f64,
+    pub rotation_error_deg: f64,
+    pub correct: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Scores {
+    pub models: usize,
+    pub images_ground_truth: usize,
+    pub registered: usize,
+    pub correct: usize,
+    /// Medians over registered images (relative position error, degrees); null when none.
+    pub median_position_error: Option<f64>,
+    pub median_rotation_error_deg: Option<f64>,
+    pub images: Vec<ImageScore>,
+}
+
+/// Scores every model under `sparse` (one model folder or a folder of sub-models) against the
+/// ground-truth model in `ground_truth`. An image registered in several sub-models counts once,
+/// with its best score.
+pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
+    let truth = model::read_images(ground_truth)?;
+    ensure!(
+        truth.len() >= 3,
+        "ground truth {} has fewer than 3 images",
+        ground_truth.display()
+    );
+    let dirs = model::model_dirs(sparse)?;
+    let mut best: HashMap<String, ImageScore> = HashMap::new();
+    for (index, dir) in dirs.iter().enumerate() {
+        let estimated = model::read_images(dir)?;
+        // A model of fewer than 2 known images cannot be aligned: its images stay unscored.
+        let Ok(eval) = align::evaluate(&estimated, &truth) else {
+            continue;
+        };
+        for (name, position, rotation) in eval.errors {
+            let score = ImageScore {
+                model: index,
+                position_error: position / eval.extent,
+                rotation_error_deg: rotation,
+                correct: position < POSITION_TOLERANCE * eval.extent
+                    && rotation < ROTATION_TOLERANCE_DEG,
+                name: name.clone(),
+            };
+            let better = |old: &ImageScore| {
+                (score.correct, -score.position_error) > (old.correct, -old.position_error)
+            };
+            if best.get(&name).is_none_or(better) {
+                best.insert(name, score);
+            }
+        }
+    }
+    let mut images: Vec<ImageScore> = best.into_values().collect();
+    images.sort_by(|a, b| a.name.cmp(&b.name));
+    let median = |mut v: Vec<f64>| -> Option<f64> {
+        v.sort_by(f64::total_cmp);
+        (!v.is_empty()).then(|| v[v.len() / 2])
+    };
+    Ok(Scores {
+        models: dirs.len(),
+        images_ground_truth: truth.len(),
+        registered: images.len(),
+        correct: images.iter().filter(|s| s.correct).count(),
+        median_position_error: median(images.iter().map(|s| s.position_error).collect()),
+        median_rotation_error_deg: median(images.iter().map(|s| s.rotation_error_deg).collect()),
+        images,
+    })
+}
+
+/// What a model says without ground truth: its number of sub-models and of distinct images.
+#[derive(Clone, Debug, Serialize)]
+pub struct Registered {
+    pub models: usize,
+    pub registered: usize,
+}
+
+/// Counts the sub-models under `sparse` and the distinct image names they register.
+pub fn registered(sparse: &Path) -> Result<Registered> {
+    let dirs = model::model_dirs(sparse)?;
+    let mut names = std::collections::HashSet::new();
+    for dir in &dirs {
+        names.extend(model::read_images(dir)?.into_iter().map(|im| im.name));
+    }
+    Ok(Registered {
+        models: dirs.len(),
+        registered: names.len(),
+    })
+}

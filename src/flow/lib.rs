@@ -1,0 +1,9 @@
+//! The paper's selection network and its exact min-cost flow, independent of COLMAP: the network,
+//! the parametric solver, the search over F, the plain-text graph format and synthetic graphs.
+
+pub mod graph_file;
+pub mod network;
+pub mod search;
+pub mod solver;
+#[cfg(feature = "synthetic")]
+pub mod synthetic_graph;

@@ -1,0 +1,269 @@
+//! Choice of the flow F: fixed, or the smallest F whose selection meets the criteria.
+//!
+//! One [`ParametricSolver`] run gives the min-cost selection for F = 1, 2, ... in turn, so the
+//! criteria search simply augments until the selection meets both targets: the F found is the
+//! exact smallest such F (the paper doubles F and bisects, with one full solve per probe).
+//!
+//! Targets, with n = number of images in the problem: images selected >= ceil(A n) and pairs
+//! selected >= min(max(ceil(B n), ceil(P |E|)), |E|).
+//!
+//! When no F meets both targets the full graph is kept (`capped`): every image and every pair
+//! selected, including images without pairs. Its `flow` is |E| and its `cost` is that of the
+//! feasible flow of value |E| saturating every pair arc and every image arc
+//! (sum_ij c_ij + sum_i deg(i) c_i). The search stops early when the targets are provably out of
+//! reach: an image without pairs can never carry flow, and since every selected pair feeds one
+//! more image arc, images' flows sum to F + pairs <= 2|E|, so pairs <= 2|E| - F and no F beyond
+//! 2|E| - target_pairs can meet the pair target.
+//!
+//! In practice a search is capped by the image criterion only: with strictly negative costs the
+//! min-cost flow of value |E| is the full graph (every image arc saturated, every pair selected:
+//! dropping a pair loses its cost and one image-arc unit), so the pair target min(ceil(B n), |E|)
+//! is met at the latest at F = |E|; only zero costs (ties) can prevent it. Images without pairs
+//! never carry flow, so A n above the number of images with pairs caps the search at once.
+
+use crate::network::{Selection, SelectionProblem};
+use crate::solver::ParametricSolver;
+use serde::Serialize;
+
+#[derive(Clone, Copy, Debug)]
+pub enum FlowRule {
+    Fixed(u64),
+    Criteria(Criteria),
+}
+
+impl FlowRule {
+    /// A fixed flow when `flow` is set, else the criteria, each taken from `defaults` (image
+    /// fraction, pairs per image, pair fraction) where unset.
+    pub fn new(
+        flow: Option<u64>,
+        min_image_fraction: Option<f64>,
+        min_pairs_per_image: Option<f64>,
+        min_pair_fraction: Option<f64>,
+        defaults: (f64, f64, f64),
+    ) -> FlowRule {
+        match flow {
+            Some(f) => FlowRule::Fixed(f),
+            None => FlowRule::Criteria(Criteria {
+                min_image_fraction: min_image_fraction.unwrap_or(defaults.0),
+                min_pairs_per_image: min_pairs_per_image.unwrap_or(defaults.1),
+                min_pair_fraction: min_pair_fraction.unwrap_or(defaults.2),
+            }),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Criteria {
+    /// Selected images / images in the view graph.
+    pub min_image_fraction: f64,
+    /// Selected pairs >= this x images in the view graph (capped at all pairs).
+    pub min_pairs_per_image: f64,
+    /// ... and >= this share of all pairs: the paper's criterion for its dense lab scenes
+    /// (about 25% of the edges); 0 for the others.
+    pub min_pair_fraction: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct CriterionStatus {
+    pub name: String,
+    pub target: f64,
+    pub achieved: f64,
+    pub met: bool,
+    /// The criterion that was met last as F grew (the one that set F).
+    pub binding: bool,
+}
+
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct CurvePoint {
+    pub flow: u64,
+    pub images_selected: usize,
+    pub pairs_selected: usize,
+}
+
+#[derive(Clone, Debug)]
+pub struct SearchResult {
+    pub selection: Selection,
+    pub criteria: Vec<CriterionStatus>,
+    /// True when no F met the criteria and the full graph was kept instead.
+    pub capped: bool,
+    /// Images and pairs selected for F = 1, 2, ... up to the chosen F.
+    pub curve: Vec<CurvePoint>,
+    /// The curve past the last F in `curve`, when asked for ([`search_with_curve`]).
+    pub beyond: Vec<CurvePoint>,
+}
+
+/// Target counts (images, pairs) of `criteria` for `problem`.
+pub fn targets(problem: &SelectionProblem, criteria: &Criteria) -> (usize, usize) {
+    let n = problem.image_costs.len() as f64;
+    let images = (criteria.min_image_fraction * n).ceil().max(0.0) as usize;
+    let m = problem.pairs.len();
+    let per_image = (criteria.min_pairs_per_image * n).ceil().max(0.0) as usize;
+    let fraction = (criteria.min_pair_fraction * m as f64).ceil().max(0.0) as usize;
+    let pairs = per_image.max(fraction).min(m);
+    (images, pairs)
+}
+
+/// The full graph as a selection (see the module doc).
+pub fn full_selection(problem: &SelectionProblem) -> Selection {
+    let n = problem.image_costs.len();
+    let mut deg = vec![0u64; n];
+    let mut cost = 0.0;
+    for p in &problem.pairs {
+        deg[p.i as usize] += 1;
+        deg[p.j as usize] += 1;
+        cost += p.cost;
+    }
+    for (d, c) in deg.iter().zip(&problem.image_costs) {
+        cost += *d as f64 * c;
+    }
+    Selection {
+        flow: problem.pairs.len() as u64,
+        images: vec![true; n],
+        pairs: vec![true; problem.pairs.len()],
+        cost,
+    }
+}
+
+fn point(solver: &ParametricSolver) -> CurvePoint {
+    CurvePoint {
+        flow: solver.flow(),
+        images_selected: solver.images_selected(),
+        pairs_selected: solver.pairs_selected(),
+    }
+}
+
+/// Runs `rule` on `problem`. The curve starts at F = 0 and ends at the chosen F (for a capped
+/// criteria search: at the last F examined).
+pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
+    search_with_curve(problem, rule, 0)
+}
+
+/// [`search`], then the same solver goes on past the chosen F to record `beyond`: up to `factor`
+/// times that F (at most 2|E|), stopping once every pair is selected (`--plots` draws what more
+/// flow would buy). The selection stays the chosen one. `factor` 0 records nothing more.
+pub fn search_with_curve(problem: &SelectionProblem, rule: &FlowRule, factor: u64) -> SearchResult {
+    let mut solver = ParametricSolver::new(problem);
+    let mut result = run(&mut solver, problem, rule);
+    if factor > 0 {
+        let chosen = result.selection.flow.max(1);
+        let limit = (factor * chosen).min(2 * problem.pairs.len() as u64);
+        let all_pairs = |solver: &ParametricSolver| {
+            solver.pairs_selected() == problem.pairs.len() && solver.flow() >= chosen
+        };
+        while !all_pairs(&solver) && solver.flow() < limit && solver.augment().is_some() {
+            result.beyond.push(point(&solver));
+        }
+    }
+    result
+}
+
+fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
+    let mut curve = vec![point(solver)];
+    match *rule {
+        FlowRule::Fixed(f) => {
+            while solver.flow() < f && solver.augment().is_some() {
+                curve.push(point(solver));
+            }
+            SearchResult {
+                selection: solver.selection(),
+                criteria: Vec::new(),
+                capped: false,
+                curve,
+                beyond: Vec::new(),
+            }
+        }
+        FlowRule::Criteria(criteria) => {
+            let (target_images, target_pairs) = targets(problem, &criteria);
+            let meets = |p: &CurvePoint| {
+                (
+                    p.images_selected >= target_images,
+                    p.pairs_selected >= target_pairs,
+                )
+            };
+            let reachable_images = {
+                let mut has_pair = vec![false; problem.image_costs.len()];
+                for p in &problem.pairs {
+                    has_pair[p.i as usize] = true;
+                    has_pair[p.j as usize] = true;
+                }
+                has_pair.iter().filter(|&&b| b).count()
+            };
+            // Beyond this F the pair target is out of reach (pairs <= 2|E| - F).
+            let last_useful = 2 * problem.pairs.len() as u64 - target_pairs as u64;
+            let mut ever = (false, false);
+            let mut found = None;
+            let mut prev = (false, false);
+            if target_images > reachable_images {
+                // Out of reach from the start: only the image criterion is to blame.
+                ever = (false, true);
+            } else {
+                loop {
+                    let p = *curve.last().unwrap();
+                    let m = meets(&p);
+                    ever = (ever.0 || m.0, ever.1 || m.1);
+                    if m.0 && m.1 {
+                        found = Some(p);
+                        break;
+                    }
+                    prev = m;
+                    if solver.flow() >= last_useful || solver.augment().is_none() {
+                        break;
+                    }
+                    curve.push(point(solver));
+                }
+            }
+            let status =
+                |name: &str, target: usize, achieved: usize, binding: bool| CriterionStatus {
+                    name: name.to_string(),
+                    target: target as f64,
+                    achieved: achieved as f64,
+                    met: achieved >= target,
+                    binding,
+                };
+            match found {
+                Some(p) => {
+                    // Binding: not met at F - 1 (none at F = 0, where nothing was needed).
+                    let first = p.flow == 0;
+                    let criteria = vec![
+                        status(
+                            "images",
+                            target_images,
+                            p.images_selected,
+                            !first && !prev.0,
+                        ),
+                        status("pairs", target_pairs, p.pairs_selected, !first && !prev.1),
+                    ];
+                    SearchResult {
+                        selection: solver.selection(),
+                        criteria,
+                        capped: false,
+                        curve,
+                        beyond: Vec::new(),
+                    }
+                }
+                None => {
+                    // Binding: the criteria never met at any F examined; both if each was met
+                    // at some F but never together.
+                    let both = ever.0 && ever.1;
+                    let selection = full_selection(problem);
+                    let criteria = vec![
+                        status(
+                            "images",
+                            target_images,
+                            problem.image_costs.len(),
+                            both || !ever.0,
+                        ),
+                        status("pairs", target_pairs, problem.pairs.len(), both || !ever.1),
+                    ];
+                    SearchResult {
+                        selection,
+                        criteria,
+                        capped: true,
+                        curve,
+                        beyond: Vec::new(),
+                    }
+                }
+            }
+        }
+    }
+}

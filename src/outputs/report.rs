@@ -1,0 +1,256 @@
+//! What a prune did: the JSON report (`--report FILE`) and the short summary on stderr.
+
+use crate::flow::search::CriterionStatus;
+use crate::scene::view_graph::{GraphStats, ViewGraph};
+use crate::selection::overrides::Listed;
+use crate::selection::parameters::Parameters;
+use crate::selection::pipeline::{Plan, Timings};
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// Version of the report's layout; bumped when a field changes meaning or disappears.
+pub const SCHEMA_VERSION: u32 = 1;
+
+#[derive(Debug, Serialize)]
+pub struct Report {
+    pub schema_version: u32,
+    pub tool_version: &'static str,
+    pub database_path: String,
+    /// Where the pruned database was written (the input itself unless `--output`); null on a dry run.
+    pub output_path: Option<String>,
+    pub dry_run: bool,
+    pub parameters: serde_json::Value,
+    pub flow: u64,
+    /// True when no flow met the criteria and the full view graph was kept.
+    pub capped: bool,
+    pub images_total: usize,
+    pub images_in_view_graph: usize,
+    pub images_selected: usize,
+    /// Names of images without any verified pair of at least `min_num_matches` inliers.
+    pub images_isolated: Vec<String>,
+    /// two_view_geometries rows with inliers (below `min_num_matches` too).
+    pub pairs_verified: usize,
+    /// View-graph edges (pairs with at least `min_num_matches` inliers).
+    pub pairs_total: usize,
+    pub pairs_selected: usize,
+    pub pairs_invalidated: usize,
+    /// The fitness floor applied: the cost model's `min_pair_fitness`, lowered (with a
+    /// searched flow) until the image criterion's number of images keep a pair reaching it.
+    pub fitness_floor: f64,
+    /// Edges never offered to the flow: fitness below `fitness_floor`.
+    pub pairs_below_fitness_floor: usize,
+    pub graph_before: GraphStats,
+    pub graph_after: GraphStats,
+    /// Of the flow's selection, before kept pairs are added (see docs/report.md).
+    pub criteria: Vec<CriterionStatus>,
+    pub priors: Vec<PriorSummary>,
+    pub overrides: Listed,
+    pub order: OrderReport,
+    /// Files written besides the database: filled in by the command as it writes them.
+    pub outputs: Outputs,
+    pub timings: Timings,
+}
+
+/// Paths of the extra files a prune wrote (null or empty when not asked for).
+#[derive(Debug, Default, Serialize)]
+pub struct Outputs {
+    pub pairs_out: Option<String>,
+    pub plots: Vec<String>,
+}
+
+/// The order the pair arcs followed and how sequential the pairs are in it.
+#[derive(Debug, Serialize)]
+pub struct OrderReport {
+    pub name: crate::selection::capture_order::Order,
+    /// Share of the selected pairs whose images are at most `window` positions apart (null when
+    /// none is selected), and the same over the whole view graph for comparison.
+    pub selected_within_window: Option<f64>,
+    pub view_graph_within_window: Option<f64>,
+    pub window: u32,
+    /// With the `exif` order: images without a capture time (placed last, by name).
+    pub images_without_time: usize,
+}
+
+/// Spread of one prior's fitness over all images or pairs, and over the selected ones.
+#[derive(Debug, Serialize)]
+pub struct PriorSummary {
+    pub name: &'static str,
+    pub applies_to: &'static str,
+    pub mean_fitness: f64,
+    pub mean_fitness_selected: f64,
+    /// Over the images or pairs the selection left out (0 when none).
+    pub mean_fitness_removed: f64,
+}
+
+impl Report {
+    pub fn new(
+        plan: &Plan,
+        database_path: String,
+        output_path: Option<String>,
+        parameters: &Parameters,
+    ) -> Report {
+        let selection = &plan.search.selection;
+        let after = ViewGraph::build(&plan.images, &plan.selected_pairs(), 1);
+        let names: HashMap<u32, &str> = plan
+            .images
+            .iter()
+            .map(|im| (im.image_id, im.name.as_str()))
+            .collect();
+        let mut isolated: Vec<String> = plan
+            .graph
+            .isolated
+            .iter()
+            .map(|id| names[id].to_string())
+            .collect();
+        isolated.sort();
+        let summarise = |fitness: &[crate::priors::PriorValues], kept: &[bool], applies_to| {
+            let mean_where = |values: &[f64], want: bool| {
+                mean(
+                    values
+                        .iter()
+                        .zip(kept)
+                        .filter(|(_, &k)| k == want)
+                        .map(|(&v, _)| v),
+                )
+            };
+            fitness
+                .iter()
+                .map(|f| PriorSummary {
+                    name: f.name,
+                    applies_to,
+                    mean_fitness: mean(f.values.iter().copied()),
+                    mean_fitness_selected: mean_where(&f.values, true),
+                    mean_fitness_removed: mean_where(&f.values, false),
+                })
+                .collect::<Vec<_>>()
+        };
+        let mut priors = summarise(&plan.costs.image_fitness, &selection.images, "images");
+        priors.extend(summarise(
+            &plan.costs.pair_fitness,
+            &selection.pairs,
+            "pairs",
+        ));
+        let order = &plan.order;
+        let window = crate::selection::capture_order::SEQUENTIAL_WINDOW;
+        let share = |kept: Option<&[bool]>| {
+            let edges = plan.graph.edges.iter().enumerate();
+            order.share_within(
+                edges
+                    .filter(|(k, _)| kept.is_none_or(|kept| kept[*k]))
+                    .map(|(_, e)| (e.i, e.j)),
+                window,
+            )
+        };
+        Report {
+            schema_version: SCHEMA_VERSION,
+            tool_version: env!("CARGO_PKG_VERSION"),
+            dry_run: output_path.is_none(),
+            database_path,
+            output_path,
+            parameters: serde_json::to_value(parameters).expect("parameters serialise"),
+            flow: selection.flow,
+            capped: plan.search.capped,
+            images_total: plan.images.len(),
+            images_in_view_graph: plan.graph.num_vertices(),
+            images_selected: selection.images.iter().filter(|&&s| s).count(),
+            images_isolated: isolated,
+            pairs_verified: plan.pairs.len(),
+            pairs_total: plan.graph.edges.len(),
+            pairs_selected: selection.pairs.iter().filter(|&&s| s).count(),
+            pairs_invalidated: plan.invalidate.len(),
+            fitness_floor: plan.fitness_floor,
+            pairs_below_fitness_floor: plan.below_fitness_floor,
+            graph_before: plan.graph.stats(),
+            graph_after: after.stats(),
+            criteria: plan.search.criteria.clone(),
+            priors,
+            overrides: plan.overrides.clone(),
+            order: OrderReport {
+                name: order.order,
+                selected_within_window: share(Some(&selection.pairs)),
+                view_graph_within_window: share(None),
+                window,
+                images_without_time: order.images_without_time,
+            },
+            outputs: Outputs::default(),
+            timings: plan.timings.clone(),
+        }
+    }
+
+    /// Two or three lines for a person.
+    pub fn summary(&self) -> String {
+        let pct = |a: usize, b: usize| {
+            if b == 0 {
+                0.0
+            } else {
+                100.0 * a as f64 / b as f64
+            }
+        };
+        let binding = self
+            .criteria
+            .iter()
+            .find(|c| c.binding)
+            .map(|c| c.name.as_str());
+        let why = match (self.capped, binding) {
+            (true, _) => "no flow met the criteria: full graph kept".to_string(),
+            (false, Some(name)) => format!("set by the {name} criterion"),
+            (false, None) => "fixed by --flow".to_string(),
+        };
+        let mut s = format!(
+            "selected {} of {} pairs ({:.1}%) and {} of {} images at flow F = {} ({why})\n",
+            self.pairs_selected,
+            self.pairs_total,
+            pct(self.pairs_selected, self.pairs_total),
+            self.images_selected,
+            self.images_in_view_graph,
+            self.flow,
+        );
+        s += &format!(
+            "components: {} before, {} after; {} pairs invalidated{}",
+            self.graph_before.components,
+            self.graph_after.components,
+            self.pairs_invalidated,
+            if self.dry_run {
+                " (dry run: nothing written)"
+            } else {
+                ""
+            }
+        );
+        if let Some(share) = self.order.selected_within_window {
+            s += &format!(
+                "\npair arcs in {} order: {:.0}% of the selected pairs are within {} positions",
+                serde_json::to_value(self.order.name)
+                    .unwrap_or_default()
+                    .as_str()
+                    .unwrap_or(""),
+                100.0 * share,
+                self.order.window
+            );
+        }
+        let o = &self.overrides;
+        if !(o.keep_pairs.is_empty() && o.forbid_pairs.is_empty() && o.forbid_images.is_empty()) {
+            s += &format!(
+                "\noverrides: {} pairs kept, {} pairs and {} images forbidden",
+                o.keep_pairs.len(),
+                o.forbid_pairs.len(),
+                o.forbid_images.len()
+            );
+        }
+        if !self.images_isolated.is_empty() {
+            s += &format!(
+                "\n{} images have no verified pair and were left alone",
+                self.images_isolated.len()
+            );
+        }
+        s
+    }
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}

@@ -1,0 +1,89 @@
+//! A prune's parameters as one typed record: what the selection ran with. `prune` stores it in
+//! the database's run record (`vgsel_runs.parameters`, [`crate::colmap::rewrite::RunRecord`]) and
+//! `export` reads it back to recompute the very costs that drove the selection.
+
+use crate::costs::CostModel;
+use crate::flow::search::FlowRule;
+use crate::selection::capture_order::{self, Order};
+use crate::selection::pipeline::Options;
+use crate::selection::preset::Preset;
+use serde::{Deserialize, Serialize};
+
+/// Everything that decides a selection, besides the database.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Parameters {
+    /// The preset named.
+    pub preset: Preset,
+    /// The cost model used: the preset's, with any weight and fitness-floor overrides applied.
+    pub cost_model: CostModel,
+    /// A pair is a view-graph edge when it has at least this many verified inliers.
+    pub min_num_matches: usize,
+    /// The flow F when it was fixed; None when it was searched.
+    pub flow: Option<u64>,
+    /// The search's image criterion (None with a fixed flow).
+    pub min_image_fraction: Option<f64>,
+    /// The search's pair criterion (None with a fixed flow).
+    pub min_pairs_per_image: Option<f64>,
+    /// The search's share-of-pairs criterion (None with a fixed flow or in older records).
+    #[serde(default)]
+    pub min_pair_fraction: Option<f64>,
+    /// The order the network's pair arcs follow (image_id in older records).
+    #[serde(default)]
+    pub order: Order,
+    /// The image folder read for the `exif` order.
+    #[serde(default)]
+    pub image_path: Option<String>,
+    /// The override files given (paths as given), for the record.
+    pub keep_pairs: Option<String>,
+    /// See `keep_pairs`.
+    pub forbid_pairs: Option<String>,
+    /// See `keep_pairs`.
+    pub forbid_images: Option<String>,
+}
+
+impl Parameters {
+    /// A preset's parameters: its cost model and search criteria, no overrides.
+    pub fn of_preset(preset: Preset, min_num_matches: usize) -> Parameters {
+        let (fraction, per_image, pair_fraction) = preset.criteria();
+        Parameters {
+            preset,
+            cost_model: preset.model(),
+            min_num_matches,
+            flow: None,
+            min_image_fraction: Some(fraction),
+            min_pairs_per_image: Some(per_image),
+            min_pair_fraction: Some(pair_fraction),
+            order: Order::default(),
+            image_path: None,
+            keep_pairs: None,
+            forbid_pairs: None,
+            forbid_images: None,
+        }
+    }
+
+    /// The flow rule: the fixed F, or the search criteria (the preset's where unset).
+    pub fn rule(&self) -> FlowRule {
+        FlowRule::new(
+            self.flow,
+            self.min_image_fraction,
+            self.min_pairs_per_image,
+            self.min_pair_fraction,
+            self.preset.criteria(),
+        )
+    }
+
+    /// The pipeline's options; `unweighted_priors` also computes the priors of weight 0.
+    pub fn options(&self, unweighted_priors: bool) -> Options {
+        Options {
+            min_num_matches: self.min_num_matches,
+            rule: self.rule(),
+            model: self.cost_model.clone(),
+            unweighted_priors,
+            curve_factor: 0,
+            capture: capture_order::Input {
+                order: self.order,
+                image_path: self.image_path.as_ref().map(Into::into),
+            },
+        }
+    }
+}

@@ -1,0 +1,379 @@
+//! The prune pipeline up to the selection: read the database, build the view graph, compute the
+//! priors and costs, run the flow search. It writes nothing; [`crate::colmap::rewrite`] applies the plan.
+
+use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, VerifiedPair};
+use crate::colmap::ids::pair_id;
+use crate::costs::{self, CostModel, Costs};
+use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
+use crate::flow::search::{self, FlowRule, SearchResult};
+use crate::priors::pairs::FocalEstimate;
+use crate::priors::{self, PriorValues};
+use crate::scene::view_graph::ViewGraph;
+use crate::scene::Scene;
+use crate::selection::capture_order::{self, CaptureOrder};
+use crate::selection::overrides::{Listed, Overrides};
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// COLMAP's default `--Mapper.min_num_matches`: fewer verified inliers make no view-graph edge.
+pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;
+
+/// What the pipeline runs with (built from [`crate::selection::parameters::Parameters`]).
+pub struct Options {
+    pub min_num_matches: usize,
+    pub rule: FlowRule,
+    pub model: CostModel,
+    /// Also compute the model's priors of weight 0 (they do not change the costs): for
+    /// `--scores`. Otherwise they are skipped, which matters at scale (multiple motions run a
+    /// RANSAC per pair).
+    pub unweighted_priors: bool,
+    /// Continue the selection curve to this many times the chosen F (0: stop there), for plots.
+    pub curve_factor: u64,
+    /// The order the network's pair arcs follow.
+    pub capture: capture_order::Input,
+}
+
+/// Seconds spent in each stage.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Timings {
+    pub read: f64,
+    pub priors: f64,
+    pub solve: f64,
+    pub write: f64,
+    pub total: f64,
+}
+
+/// Everything decided before writing.
+pub struct Plan {
+    pub images: Vec<Image>,
+    pub pairs: Vec<VerifiedPair>,
+    pub graph: ViewGraph,
+    /// Raw prior values, indexed like the graph's vertices (image priors) or edges (pair priors).
+    pub image_priors: Vec<PriorValues>,
+    pub pair_priors: Vec<PriorValues>,
+    pub costs: Costs,
+    /// Focal lengths estimated where the database had only a guess.
+    pub focal_estimates: Vec<FocalEstimate>,
+    /// The network the flow ran on (the view graph less the overrides' arcs).
+    pub network: Restriction,
+    pub overrides: Listed,
+    /// The order the pair arcs followed.
+    pub order: CaptureOrder,
+    /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
+    pub search: SearchResult,
+    /// The fitness floor applied ([`fitness_floor`]) and the edges it left out of the network.
+    pub fitness_floor: f64,
+    pub below_fitness_floor: usize,
+    /// pair_ids of the view-graph edges the selection leaves out.
+    pub invalidate: Vec<u64>,
+    pub timings: Timings,
+}
+
+impl Plan {
+    /// The selected edges' verified pairs.
+    pub fn selected_pairs(&self) -> Vec<VerifiedPair> {
+        self.graph
+            .edges
+            .iter()
+            .zip(&self.search.selection.pairs)
+            .filter(|(_, &kept)| kept)
+            .map(|(e, _)| self.pairs[e.pair].clone())
+            .collect()
+    }
+}
+
+/// Reads the database and decides the selection. `stage` is told the name of each long step.
+pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Plan> {
+    plan_with(db, options, &Overrides::default(), stage)
+}
+
+/// [`plan`] honouring user overrides (see [`crate::selection::overrides`]).
+pub fn plan_with(
+    db: &Database,
+    options: &Options,
+    overrides: &Overrides,
+    stage: &dyn Fn(&str),
+) -> Result<Plan> {
+    let started = Instant::now();
+    let mut timings = Timings::default();
+
+    stage("reading images and verified pairs");
+    let images = db.images()?;
+    let cameras = db.cameras()?;
+    let pairs = db.verified_pairs()?;
+    if pairs.is_empty() {
+        bail!("no verified image pairs in two_view_geometries: run a COLMAP matcher first");
+    }
+    let graph = ViewGraph::build(&images, &pairs, options.min_num_matches);
+    if graph.edges.is_empty() {
+        bail!(
+            "no image pair has at least {} verified inliers (--min_num_matches)",
+            options.min_num_matches
+        );
+    }
+    let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
+    let names = options.model.pair_prior_names(options.unweighted_priors);
+    let scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
+    let order = capture_order::compute(&options.capture, &graph, &images, &pairs)?;
+    timings.read = started.elapsed().as_secs_f64();
+
+    stage("computing priors");
+    let t = Instant::now();
+    let image_priors = priors::general_image_priors(&scene);
+    let pair_priors = priors::pairs::compute(&scene, &names, stage)?;
+    let costs = costs::compute(&options.model, &image_priors, &pair_priors.values);
+    timings.priors = t.elapsed().as_secs_f64();
+
+    stage("solving the min-cost flow selection");
+    let t = Instant::now();
+    let floor = fitness_floor(options, &graph, &costs.pair_costs);
+    let mut below_fitness_floor = 0;
+    for (rule, cost) in resolved.edges.iter_mut().zip(&costs.pair_costs) {
+        if *rule == ArcRule::Free && -cost < floor {
+            *rule = ArcRule::Removed;
+            below_fitness_floor += 1;
+        }
+    }
+    let network = problem(&graph, &costs, &order).restrict(
+        &order.by_rank(&resolved.forbidden_vertices),
+        &resolved.edges,
+    );
+    let mut search =
+        search::search_with_curve(&network.problem, &options.rule, options.curve_factor);
+    search.selection = network.expand(&search.selection);
+    search.selection.images = order.by_vertex(&search.selection.images);
+    timings.solve = t.elapsed().as_secs_f64();
+
+    let invalidate = graph
+        .edges
+        .iter()
+        .zip(&search.selection.pairs)
+        .filter(|(_, &kept)| !kept)
+        .map(|(e, _)| pair_id(pairs[e.pair].image_id1, pairs[e.pair].image_id2))
+        .collect();
+    timings.total = started.elapsed().as_secs_f64();
+    Ok(Plan {
+        images,
+        pairs,
+        graph,
+        image_priors,
+        pair_priors: pair_priors.values,
+        focal_estimates: pair_priors.focal_estimates,
+        costs,
+        network,
+        overrides: resolved.listed,
+        order,
+        search,
+        fitness_floor: floor,
+        below_fitness_floor,
+        invalidate,
+        timings,
+    })
+}
+
+/// The paper's network on the whole view graph: images indexed by their position in `order`
+/// (which orients the pair arcs, lower to higher), pair arcs in view-graph edge order.
+fn problem(graph: &ViewGraph, costs: &Costs, order: &CaptureOrder) -> SelectionProblem {
+    SelectionProblem {
+        image_costs: order.by_rank(&costs.image_costs),
+        pairs: graph
+            .edges
+            .iter()
+            .zip(&costs.pair_costs)
+            .map(|(e, &cost)| {
+                let (a, b) = (order.rank[e.i as usize], order.rank[e.j as usize]);
+                PairArc {
+                    i: a.min(b),
+                    j: a.max(b),
+                    cost,
+                }
+            })
+            .collect(),
+    }
+}
+
+/// Reads what the priors `names` need of the database into a [`Scene`] of `graph`: keypoints
+/// and image sizes always; cameras and stored geometries for the pose priors; raw matches for
+/// multiple motions. The only place the priors' inputs come from the database.
+fn load_scene<'a>(
+    db: &Database,
+    graph: &'a ViewGraph,
+    pairs: &'a [VerifiedPair],
+    images: &[Image],
+    cameras: Vec<Camera>,
+    names: &[&str],
+    stage: &dyn Fn(&str),
+) -> Result<Scene<'a>> {
+    let camera_of: HashMap<u32, u32> = images
+        .iter()
+        .map(|im| (im.image_id, im.camera_id))
+        .collect();
+    let camera_ids: Vec<u32> = graph.image_ids.iter().map(|id| camera_of[id]).collect();
+    let sizes: HashMap<u32, (u32, u32)> = cameras
+        .iter()
+        .map(|c| (c.camera_id, (c.width, c.height)))
+        .collect();
+    let image_sizes = graph
+        .image_ids
+        .iter()
+        .zip(&camera_ids)
+        .map(|(id, camera)| {
+            sizes
+                .get(camera)
+                .copied()
+                .with_context(|| format!("image {id} names camera {camera}, which does not exist"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    stage("reading keypoints");
+    let keypoints = graph
+        .image_ids
+        .iter()
+        .map(|&id| db.keypoints_xy(id))
+        .collect::<Result<Vec<_>>>()?;
+    let mut scene = Scene::new(graph, pairs, keypoints, image_sizes);
+    let needs = priors::pairs::needs(names);
+    if needs.geometry {
+        scene.cameras = cameras
+            .into_iter()
+            .filter(|c| camera_ids.contains(&c.camera_id))
+            .collect();
+        let mut stored: HashMap<(u32, u32), TwoViewGeometry> = db
+            .geometries()?
+            .into_iter()
+            .map(|g| ((g.image_id1, g.image_id2), g))
+            .collect();
+        scene.geometries = graph
+            .edges
+            .iter()
+            .map(|e| stored.remove(&(pairs[e.pair].image_id1, pairs[e.pair].image_id2)))
+            .collect();
+    }
+    scene.camera_ids = camera_ids;
+    if needs.matches {
+        stage("reading raw matches");
+        scene.matches = graph
+            .edges
+            .iter()
+            .map(|e| db.matches(graph.image_ids[e.i as usize], graph.image_ids[e.j as usize]))
+            .collect::<Result<Vec<_>>>()?;
+    }
+    Ok(scene)
+}
+
+/// The cost model's `min_pair_fitness`, lowered where needed so that the image criterion's
+/// share of images keep a pair above it, and at least half as many pairs as the pair criterion
+/// asks for reach it. On scenes where the priors score every pair low (real photos where few
+/// triangles close within the loop tolerance) a fixed floor left the flow too few pairs for
+/// `colmap mapper` to start a model (docs/priors.md). With a fixed flow it is applied as given.
+pub fn fitness_floor(options: &Options, graph: &ViewGraph, pair_costs: &[f64]) -> f64 {
+    let floor = options.model.min_pair_fitness;
+    let FlowRule::Criteria(criteria) = &options.rule else {
+        return floor;
+    };
+    let n = graph.num_vertices();
+    if floor <= 0.0 || n == 0 {
+        return floor;
+    }
+    // The k-th largest of some values (k >= 1, at most their count).
+    let kth = |mut values: Vec<f64>, k: usize| {
+        let k = k.clamp(1, values.len());
+        *values
+            .select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a))
+            .1
+    };
+    // Each image's best pair fitness: the wanted-th best image sets the highest usable floor.
+    let mut best = vec![0.0f64; n];
+    for (e, cost) in graph.edges.iter().zip(pair_costs) {
+        for v in [e.i as usize, e.j as usize] {
+            best[v] = best[v].max(-cost);
+        }
+    }
+    let images = (criteria.min_image_fraction * n as f64).ceil() as usize;
+    let pairs = (criteria.min_pairs_per_image * n as f64 / 2.0).ceil() as usize;
+    let fitness = pair_costs.iter().map(|c| -c).collect();
+    floor.min(kth(best, images)).min(kth(fitness, pairs))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flow::search::Criteria;
+    use crate::scene::testing::{images, pair};
+
+    /// The order decides what one unit of flow selects: on a triangle of equal costs the flow
+    /// takes the two pairs along the order and leaves the pair that skips the middle image.
+    #[test]
+    fn the_network_orients_its_arcs_by_the_capture_order() {
+        let images = images(3);
+        let pairs: Vec<VerifiedPair> = [(1, 2), (2, 3), (1, 3)]
+            .map(|(a, b)| pair(a, b, vec![[0, 0]; 50]))
+            .to_vec();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let costs = Costs {
+            image_costs: vec![0.0; 3],
+            pair_costs: vec![-1.0; 3],
+            image_fitness: Vec::new(),
+            pair_fitness: Vec::new(),
+        };
+        let skipped = |rank: Vec<u32>| {
+            let order = CaptureOrder {
+                order: capture_order::Order::Name,
+                rank,
+                images_without_time: 0,
+            };
+            let whole = problem(&graph, &costs, &order);
+            assert!(whole.pairs.iter().all(|p| p.i < p.j));
+            let selection = search::search(&whole, &FlowRule::Fixed(1)).selection;
+            let left: Vec<(u32, u32)> = graph
+                .edges
+                .iter()
+                .zip(&selection.pairs)
+                .filter(|(_, &kept)| !kept)
+                .map(|(e, _)| (graph.image_ids[e.i as usize], graph.image_ids[e.j as usize]))
+                .collect();
+            left
+        };
+        assert_eq!(skipped(vec![0, 1, 2]), [(1, 3)]);
+        assert_eq!(skipped(vec![0, 2, 1]), [(1, 2)]);
+        assert_eq!(skipped(vec![1, 0, 2]), [(2, 3)]);
+    }
+
+    #[test]
+    fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {
+        // A path 1-2-3-4-5: pair fitnesses 0.9, 0.8, 0.2, 0.1.
+        let images = images(5);
+        let pairs: Vec<VerifiedPair> = (1..5).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let costs = [-0.9, -0.8, -0.2, -0.1];
+        let options = |fraction: f64, per_image: f64, rule: Option<u64>| Options {
+            min_num_matches: 15,
+            rule: match rule {
+                Some(f) => FlowRule::Fixed(f),
+                None => FlowRule::Criteria(Criteria {
+                    min_image_fraction: fraction,
+                    min_pairs_per_image: per_image,
+                    min_pair_fraction: 0.0,
+                }),
+            },
+            model: CostModel::disambiguation(),
+            unweighted_priors: false,
+            curve_factor: 0,
+            capture: Default::default(),
+        };
+        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already, and
+        // half of 0.4 pairs per image x 5 images is one pair.
+        assert_eq!(fitness_floor(&options(0.6, 0.4, None), &graph, &costs), 0.6);
+        // Four images need the floor at 0.2, all five at 0.1.
+        assert_eq!(fitness_floor(&options(0.8, 0.4, None), &graph, &costs), 0.2);
+        assert_eq!(fitness_floor(&options(1.0, 0.4, None), &graph, &costs), 0.1);
+        // Half of 1.2 pairs per image x 5 images is 3 pairs: the third best is 0.2.
+        assert_eq!(fitness_floor(&options(0.6, 1.2, None), &graph, &costs), 0.2);
+        // A fixed flow takes the floor as given.
+        assert_eq!(
+            fitness_floor(&options(1.0, 1.2, Some(3)), &graph, &costs),
+            0.6
+        );
+    }
+}

@@ -1,0 +1,55 @@
+//! The presets: each is a cost model (which priors, their g and weights, the fitness floor) and
+//! the flow-search criteria that go with it, in one place.
+
+use crate::costs::CostModel;
+use clap::ValueEnum;
+use serde::{Deserialize, Serialize};
+
+/// A named choice of cost model and search criteria (`prune --preset`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Preset {
+    /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
+    /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
+    General,
+    /// For scenes with duplicate or symmetric structure: pair priors loop consistency (rotations
+    /// and translations of every triangle) and unique tracks, pairs below fitness 0.6 never
+    /// selected; the paper's context and multiple motions at weight 0 (in --scores). Search: 80%
+    /// of images, 5 pairs per image.
+    Disambiguation,
+    /// The paper's section 5.1 as written, for its lab scenes: context similarity, loop
+    /// consistency and multiple motions with uniform weights, no fitness floor; search: 25% of
+    /// the view graph's pairs (its lab criterion), no image criterion. Relies on the pair arcs
+    /// following the capture order (--order).
+    #[serde(rename = "paper-disambiguation")]
+    PaperDisambiguation,
+}
+
+impl Preset {
+    /// The preset's name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::General => "general",
+            Preset::Disambiguation => "disambiguation",
+            Preset::PaperDisambiguation => "paper-disambiguation",
+        }
+    }
+
+    /// Which priors make the costs, with their g and weights, and the fitness floor.
+    pub fn model(self) -> CostModel {
+        match self {
+            Preset::General => CostModel::general(),
+            Preset::Disambiguation => CostModel::disambiguation(),
+            Preset::PaperDisambiguation => CostModel::paper_disambiguation(),
+        }
+    }
+
+    /// The paper's flow-search criteria: (image fraction, pairs per image, pair fraction).
+    pub fn criteria(self) -> (f64, f64, f64) {
+        match self {
+            Preset::General => (0.9, 20.0, 0.0),
+            Preset::Disambiguation => (0.8, 5.0, 0.0),
+            Preset::PaperDisambiguation => (0.0, 0.0, 0.25),
+        }
+    }
+}
