@@ -206,6 +206,24 @@ impl CostModel {
         }
     }
 
+    /// The paper's section 5.1 as written: context similarity (the paper's cosine), loop
+    /// consistency (the paper's count over the median) and multiple motions with uniform
+    /// weights (the two motion terms share one prior's weight and count only where a second
+    /// motion was found), no fitness floor. Kept as the paper has it for comparison: on real
+    /// photographs it works only with the pair arcs in capture order (docs/priors.md).
+    pub fn paper_disambiguation() -> CostModel {
+        let mut model = CostModel::disambiguation();
+        for p in &mut model.pair_priors {
+            p.weight = match p.name {
+                "context" | "loop" => 1.0,
+                "motion_rotation" | "motion_position" => 0.5,
+                _ => 0.0,
+            };
+        }
+        model.min_pair_fitness = 0.0;
+        model
+    }
+
     /// Sets a prior's weight; unknown names are an error listing the model's priors.
     pub fn set_weight(&mut self, name: &str, weight: f64) -> Result<()> {
         let all = self
@@ -328,6 +346,48 @@ fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorVal
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_papers_preset_weighs_context_loop_and_motions_uniformly_without_a_floor() {
+        let model = CostModel::paper_disambiguation();
+        let weight = |name| {
+            model
+                .pair_priors
+                .iter()
+                .find(|p| p.name == name)
+                .unwrap()
+                .weight
+        };
+        assert_eq!((weight("context"), weight("loop")), (1.0, 1.0));
+        assert_eq!(weight("motion_rotation") + weight("motion_position"), 1.0);
+        assert_eq!(model.pair_prior_names(false).len(), 4);
+        assert_eq!(model.min_pair_fitness, 0.0);
+        // Where no second motion was found, context and loop count alone.
+        let pairs = |values: [f64; 2]| {
+            ["context", "loop", "motion_rotation", "motion_position"]
+                .into_iter()
+                .zip([
+                    vec![0.0, 1.0],
+                    vec![0.0, 1.0],
+                    values.to_vec(),
+                    values.to_vec(),
+                ])
+                .map(|(name, values)| PriorValues { name, values })
+                .collect::<Vec<_>>()
+        };
+        let images: Vec<_> = ["degree", "track_fraction", "clustering"]
+            .into_iter()
+            .map(|name| PriorValues {
+                name,
+                values: vec![1.0],
+            })
+            .collect();
+        let costs = compute(&model, &images, &pairs([f64::NAN, f64::NAN]));
+        assert_eq!(costs.pair_costs, [0.0, -1.0]);
+        // A second motion 90 degrees off counts as one prior at fitness 0: (0 + 1 + 0) / 3.
+        let costs = compute(&model, &images, &pairs([90.0, 90.0]));
+        assert!((costs.pair_costs[1] + 2.0 / 3.0).abs() < 1e-12);
+    }
 
     #[test]
     fn trapezoid_pieces() {

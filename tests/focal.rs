@@ -26,6 +26,7 @@ fn guessed_focal_length_is_replaced_by_the_estimate() {
         model: CostModel::general(),
         unweighted_priors: false,
         curve_factor: 0,
+        capture: Default::default(),
     };
     let p = plan(&db, &options, &|_| {}).unwrap();
     assert_eq!(p.focal_estimates.len(), 1);

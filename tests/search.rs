@@ -21,6 +21,7 @@ fn criteria(a: f64, b: f64) -> FlowRule {
     FlowRule::Criteria(Criteria {
         min_image_fraction: a,
         min_pairs_per_image: b,
+        min_pair_fraction: 0.0,
     })
 }
 
@@ -174,6 +175,25 @@ fn degenerate_inputs() {
     assert!(!status(&r, "images").binding && !status(&r, "pairs").binding);
     let r = search(&lonely, &FlowRule::Fixed(3));
     assert_eq!(r.selection.flow, 0);
+}
+
+#[test]
+fn the_pair_fraction_raises_the_pair_target_and_the_flow() {
+    let p = random_problem(80, 700, 5);
+    let with = |per_image: f64, fraction: f64| Criteria {
+        min_image_fraction: 0.0,
+        min_pairs_per_image: per_image,
+        min_pair_fraction: fraction,
+    };
+    // 25% of 700 pairs = 175 > 1 x 80 images; the larger target wins either way round.
+    assert_eq!(targets(&p, &with(1.0, 0.25)), (0, 175));
+    assert_eq!(targets(&p, &with(3.0, 0.25)), (0, 240));
+    assert_eq!(targets(&p, &with(0.0, 1.0)), (0, 700));
+    let r = search(&p, &FlowRule::Criteria(with(0.0, 0.25)));
+    let (_, pairs) = counts(&r.selection);
+    assert!(pairs >= 175 && status(&r, "pairs").binding);
+    let (_, before) = counts(&solve(&p, r.selection.flow - 1));
+    assert!(before < 175);
 }
 
 #[test]

@@ -34,10 +34,12 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         rule: FlowRule::Criteria(Criteria {
             min_image_fraction: 0.8,
             min_pairs_per_image: 5.0,
+            min_pair_fraction: 0.0,
         }),
         model: all_priors(),
         unweighted_priors: true,
         curve_factor: 0,
+        capture: Default::default(),
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();
     eprintln!("plan: {:?}", p.timings);

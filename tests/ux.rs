@@ -331,6 +331,30 @@ fn a_closed_pipe_ends_the_output_quietly() {
     assert!(!out.status.success());
 }
 
+#[test]
+fn the_capture_order_is_reported_and_exif_needs_the_images() {
+    let (dir, db) = scene();
+    let (by_id, _) = dry_run(&db, dir.path(), "id", &[]);
+    let (by_graph, _) = dry_run(&db, dir.path(), "graph", &["--order", "graph"]);
+    assert_eq!(by_id["order"]["name"], "image_id");
+    assert_eq!(by_id["parameters"]["order"], "image_id");
+    assert_eq!(by_graph["order"]["name"], "graph");
+    for r in [&by_id, &by_graph] {
+        let share = r["order"]["selected_within_window"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&share));
+        assert_eq!(r["order"]["window"], 5);
+    }
+    let before = std::fs::read(&db).unwrap();
+    let out = vgsel(&["prune", "--database_path", s(&db), "--order", "exif"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--image_path") && err.lines().count() == 1,
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&db).unwrap(), before);
+}
+
 /// The `cost` attribute of every DOT edge, keyed by the edge's image ids.
 fn dot_costs(dot: &str) -> std::collections::BTreeMap<(u32, u32), f64> {
     let attr = |line: &str, key: &str| -> String {

@@ -31,7 +31,7 @@ impl DatabaseArg {
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
@@ -41,32 +41,42 @@ pub struct FlowArgs {
     /// [default: 20, disambiguation preset 5].
     #[arg(long, value_parser = non_negative)]
     min_pairs_per_image: Option<f64>,
+    /// Search: ... and at least this fraction of the view graph's pairs
+    /// [default: 0, paper-disambiguation preset 0.25].
+    #[arg(long, value_parser = fraction)]
+    min_pair_fraction: Option<f64>,
 }
 
 impl FlowArgs {
-    /// The flow rule, with `defaults` (image fraction, pairs per image) for unset criteria.
-    pub fn rule(&self, defaults: (f64, f64)) -> FlowRule {
+    /// The flow rule, with `defaults` (image fraction, pairs per image, pair fraction) for unset
+    /// criteria.
+    pub fn rule(&self, defaults: (f64, f64, f64)) -> FlowRule {
         FlowRule::new(
             self.flow,
             self.min_image_fraction,
             self.min_pairs_per_image,
+            self.min_pair_fraction,
             defaults,
         )
     }
 
-    /// The parameters' view of these options: (fixed flow, image fraction, pairs per image),
-    /// the criteria filled from `defaults` unless the flow is fixed.
-    pub fn parts(&self, defaults: (f64, f64)) -> (Option<u64>, Option<f64>, Option<f64>) {
+    /// The parameters' view of these options: (fixed flow, image fraction, pairs per image, pair
+    /// fraction), the criteria filled from `defaults` unless the flow is fixed.
+    pub fn parts(&self, defaults: (f64, f64, f64)) -> FlowParts {
         match self.rule(defaults) {
-            FlowRule::Fixed(f) => (Some(f), None, None),
+            FlowRule::Fixed(f) => (Some(f), None, None, None),
             FlowRule::Criteria(c) => (
                 None,
                 Some(c.min_image_fraction),
                 Some(c.min_pairs_per_image),
+                Some(c.min_pair_fraction),
             ),
         }
     }
 }
+
+/// (fixed flow, image fraction, pairs per image, pair fraction) as the parameters record them.
+pub type FlowParts = (Option<u64>, Option<f64>, Option<f64>, Option<f64>);
 
 #[derive(Clone, Debug)]
 pub struct Weights(pub Vec<(String, f64)>);

@@ -10,6 +10,7 @@ use std::time::Instant;
 use vgsel_colmap::colmap::{copy, rewrite};
 use vgsel_colmap::outputs::report::{Outputs, Report};
 use vgsel_colmap::outputs::{export, plots, scores};
+use vgsel_colmap::selection::capture_order::Order;
 use vgsel_colmap::selection::overrides::{NameList, Overrides};
 use vgsel_colmap::selection::parameters::Parameters;
 use vgsel_colmap::selection::pipeline as prune;
@@ -68,6 +69,14 @@ pub struct PruneArgs {
     /// Never select these images nor any of their pairs (one name a line).
     #[arg(long, value_name = "FILE")]
     forbid_images: Option<PathBuf>,
+    /// The order the network's pair arcs follow (lower to higher): the paper's flow chains
+    /// images along it, so name the capture order when the photos are a sequence (see
+    /// docs/cli.md).
+    #[arg(long, value_enum, default_value = "image_id")]
+    order: Order,
+    /// The image folder, read for --order exif.
+    #[arg(long, value_name = "DIR")]
+    image_path: Option<PathBuf>,
 }
 
 impl PruneArgs {
@@ -122,7 +131,8 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         model.min_pair_fitness = floor;
     }
     let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
-    let (flow, min_image_fraction, min_pairs_per_image) = args.flow.parts(args.preset.criteria());
+    let (flow, min_image_fraction, min_pairs_per_image, min_pair_fraction) =
+        args.flow.parts(args.preset.criteria());
     let parameters = Parameters {
         preset: args.preset,
         cost_model: model,
@@ -130,6 +140,9 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         flow,
         min_image_fraction,
         min_pairs_per_image,
+        min_pair_fraction,
+        order: args.order,
+        image_path: path_text(&args.image_path),
         keep_pairs: path_text(&args.keep_pairs),
         forbid_pairs: path_text(&args.forbid_pairs),
         forbid_images: path_text(&args.forbid_images),

@@ -1,9 +1,9 @@
-//! Similarity alignment of camera centres and pose-error evaluation against ground truth.
+//! Similarity alignment of camera poses and pose-error evaluation against ground truth.
 //!
 //! Why: a reconstruction is only defined up to a similarity, so its poses must be aligned onto
-//! the ground truth before errors mean anything. [`umeyama`] is the closed-form least-squares
-//! fit; [`umeyama_ransac`] makes it robust to a few badly placed cameras, so one wrong image
-//! does not hide how good the rest is.
+//! the ground truth before errors mean anything. [`align_poses`] finds the similarity under which
+//! the most cameras are right in both position and rotation, so wrong images (a ghosted group)
+//! neither hide how good the rest is nor tilt the fit away from it.
 
 use crate::colmap::model::ModelImage;
 use anyhow::{bail, ensure, Result};
@@ -40,107 +40,163 @@ impl Similarity {
     }
 }
 
-/// Least-squares similarity mapping `src[i]` onto `dst[i]` (Umeyama 1991). Needs at least three
-/// points that are not collinear.
-pub fn umeyama(src: &[Vector3<f64>], dst: &[Vector3<f64>]) -> Result<Similarity> {
-    ensure!(src.len() == dst.len(), "umeyama: point counts differ");
-    ensure!(src.len() >= 3, "umeyama: needs at least 3 points");
-    let n = src.len() as f64;
-    let mu_s = src.iter().sum::<Vector3<f64>>() / n;
-    let mu_d = dst.iter().sum::<Vector3<f64>>() / n;
-    let mut cov = Matrix3::zeros();
-    let mut var_s = 0.0;
-    for (s, d) in src.iter().zip(dst) {
-        let (s, d) = (s - mu_s, d - mu_d);
-        cov += d * s.transpose();
-        var_s += s.norm_squared();
-    }
-    cov /= n;
-    var_s /= n;
-    ensure!(var_s > 1e-12, "umeyama: source points coincide");
-    let svd = cov.svd(true, true);
-    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
-    let mut sv = svd.singular_values;
-    // Sort not needed for the fit, but the rank test needs the two largest.
-    let mut sorted = [sv[0], sv[1], sv[2]];
-    sorted.sort_by(|a, b| b.total_cmp(a));
-    ensure!(
-        sorted[1] > 1e-9 * sorted[0].max(1e-300),
-        "umeyama: points are collinear"
-    );
-    let mut s = Matrix3::identity();
-    if u.determinant() * v_t.determinant() < 0.0 {
-        // Flip the axis of the smallest singular value.
-        let i = (0..3).min_by(|&a, &b| sv[a].total_cmp(&sv[b])).unwrap();
-        s[(i, i)] = -1.0;
-        sv[i] = -sv[i];
-    }
-    let rotation = Rotation3::from_matrix_unchecked(u * s * v_t);
-    let scale = sv.sum() / var_s;
-    let translation = mu_d - scale * (rotation * mu_s);
-    Ok(Similarity {
-        scale,
-        rotation,
-        translation,
-    })
+/// One camera pose in a frame: world-to-camera rotation and centre.
+#[derive(Clone, Copy, Debug)]
+pub struct Pose {
+    /// World-to-camera rotation.
+    pub rotation: Rotation3<f64>,
+    /// Camera centre in world coordinates.
+    pub centre: Vector3<f64>,
 }
 
-/// RANSAC over minimal 3-point samples, then a refit on the inliers (points whose aligned
-/// distance to their target is below `threshold`, in `dst` units). Returns the similarity and the
-/// inlier mask. Deterministic from `seed`.
-pub fn umeyama_ransac(
-    src: &[Vector3<f64>],
-    dst: &[Vector3<f64>],
-    threshold: f64,
-    iterations: usize,
+/// Cameras whose aligned centre is within `position` (truth units) and whose aligned rotation is
+/// within `rotation_deg` of the truth; the same limits that decide a correct camera.
+#[derive(Clone, Copy, Debug)]
+pub struct Tolerance {
+    /// Largest centre error, in the truth's units.
+    pub position: f64,
+    /// Largest rotation error, in degrees.
+    pub rotation_deg: f64,
+}
+
+/// The similarity estimate -> truth that agrees with the most cameras in position *and* rotation.
+///
+/// Why not centres alone: when the correct cameras lie near a line (a walk, a short arc), their
+/// centres leave the roll about that line free, and a fit that also catches a ghosted group's
+/// centres can tilt every camera beyond the rotation limit, reporting correct cameras as wrong.
+/// Each camera's rotation fixes the frame rotation on its own (`R = R_true^T R_est`), so every
+/// pair of cameras gives a full hypothesis: the rotation of the first, scale and translation by
+/// least squares from the two centres. All pairs are tried (a deterministic sample of
+/// `max_hypotheses` when there are more); the one with the most cameras inside `tolerance` wins
+/// (ties: the smaller sum of squared normalised errors), then is refined on its inliers (rotation
+/// = chordal mean of their rotations, scale and translation by least squares) as long as that
+/// does not lose a camera. Returns the similarity and the inlier mask.
+pub fn align_poses(
+    estimated: &[Pose],
+    truth: &[Pose],
+    tolerance: Tolerance,
+    max_hypotheses: usize,
     seed: u64,
 ) -> Result<(Similarity, Vec<bool>)> {
     ensure!(
-        src.len() == dst.len(),
-        "umeyama_ransac: point counts differ"
+        estimated.len() == truth.len(),
+        "align_poses: pose counts differ"
     );
-    ensure!(src.len() >= 3, "umeyama_ransac: needs at least 3 points");
-    let inliers_of = |sim: &Similarity| -> Vec<bool> {
-        src.iter()
-            .zip(dst)
-            .map(|(s, d)| (sim.apply(s) - d).norm() < threshold)
+    let n = estimated.len();
+    ensure!(n >= 2, "align_poses: needs at least 2 cameras");
+    // Per camera, the frame rotation it implies.
+    let implied: Vec<Rotation3<f64>> = estimated
+        .iter()
+        .zip(truth)
+        .map(|(e, t)| t.rotation.inverse() * e.rotation)
+        .collect();
+    let judge = |sim: &Similarity| -> (Vec<bool>, usize, f64) {
+        let mut mask = Vec::with_capacity(n);
+        let mut cost = 0.0;
+        for ((e, t), r) in estimated.iter().zip(truth).zip(&implied) {
+            let position = (sim.apply(&e.centre) - t.centre).norm() / tolerance.position;
+            let rotation = angle_deg(r, &sim.rotation) / tolerance.rotation_deg;
+            let inlier = position < 1.0 && rotation < 1.0;
+            cost += if inlier {
+                position * position + rotation * rotation
+            } else {
+                2.0
+            };
+            mask.push(inlier);
+        }
+        let count = mask.iter().filter(|&&m| m).count();
+        (mask, count, cost)
+    };
+    let total = n * (n - 1) / 2;
+    let hypotheses: Vec<(usize, usize)> = if total <= max_hypotheses {
+        (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .collect()
+    } else {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..max_hypotheses)
+            .map(|_| {
+                let idx = sample(&mut rng, n, 2);
+                (idx.index(0), idx.index(1))
+            })
             .collect()
     };
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut best: Option<(usize, Vec<bool>)> = None;
-    for _ in 0..iterations.max(1) {
-        let idx = sample(&mut rng, src.len(), 3);
-        let s: Vec<_> = idx.iter().map(|i| src[i]).collect();
-        let d: Vec<_> = idx.iter().map(|i| dst[i]).collect();
-        let Ok(sim) = umeyama(&s, &d) else { continue };
-        let mask = inliers_of(&sim);
-        let count = mask.iter().filter(|&&b| b).count();
-        if best.as_ref().is_none_or(|(c, _)| count > *c) {
-            best = Some((count, mask));
+    let mut best: Option<(Similarity, Vec<bool>, usize, f64)> = None;
+    for (i, j) in hypotheses {
+        let Some(sim) = fit_given_rotation(
+            implied[i],
+            &[estimated[i], estimated[j]],
+            &[truth[i], truth[j]],
+        ) else {
+            continue;
+        };
+        let (mask, count, cost) = judge(&sim);
+        if best
+            .as_ref()
+            .is_none_or(|b| count > b.2 || (count == b.2 && cost < b.3))
+        {
+            best = Some((sim, mask, count, cost));
         }
     }
-    let Some((count, mut mask)) = best else {
-        bail!("umeyama_ransac: every sample was degenerate")
+    let Some((mut sim, mut mask, mut count, mut cost)) = best else {
+        bail!("align_poses: every pair of cameras has coinciding centres")
     };
-    ensure!(count >= 3, "umeyama_ransac: fewer than 3 inliers");
-    // Refit on the inliers, then once more on the refit's inliers.
-    let mut sim = Similarity::identity();
-    for _ in 0..2 {
-        let (s, d): (Vec<_>, Vec<_>) = src
-            .iter()
-            .zip(dst)
-            .zip(&mask)
-            .filter(|(_, &m)| m)
-            .map(|((s, d), _)| (*s, *d))
-            .unzip();
-        sim = umeyama(&s, &d)?;
-        let refit = inliers_of(&sim);
-        if refit.iter().filter(|&&b| b).count() < 3 {
+    for _ in 0..5 {
+        let inliers: Vec<usize> = (0..n).filter(|&k| mask[k]).collect();
+        let rotation = chordal_mean(inliers.iter().map(|&k| &implied[k]));
+        let pick = |poses: &[Pose]| inliers.iter().map(|&k| poses[k]).collect::<Vec<_>>();
+        let Some(refit) = fit_given_rotation(rotation, &pick(estimated), &pick(truth)) else {
+            break;
+        };
+        let (refit_mask, refit_count, refit_cost) = judge(&refit);
+        if refit_count < count || (refit_count == count && refit_cost >= cost) {
             break;
         }
-        mask = refit;
+        (sim, mask, count, cost) = (refit, refit_mask, refit_count, refit_cost);
     }
     Ok((sim, mask))
+}
+
+/// Scale and translation by least squares once the rotation is fixed; None when the estimated
+/// centres coincide (no scale).
+fn fit_given_rotation(
+    rotation: Rotation3<f64>,
+    estimated: &[Pose],
+    truth: &[Pose],
+) -> Option<Similarity> {
+    let n = estimated.len() as f64;
+    let mu_e = estimated.iter().map(|p| p.centre).sum::<Vector3<f64>>() / n;
+    let mu_t = truth.iter().map(|p| p.centre).sum::<Vector3<f64>>() / n;
+    let (mut dot, mut var) = (0.0, 0.0);
+    for (e, t) in estimated.iter().zip(truth) {
+        let e = rotation * (e.centre - mu_e);
+        dot += e.dot(&(t.centre - mu_t));
+        var += e.norm_squared();
+    }
+    if var < 1e-18 * (1.0 + mu_e.norm_squared()) || dot <= 0.0 {
+        return None;
+    }
+    let scale = dot / var;
+    Some(Similarity {
+        scale,
+        rotation,
+        translation: mu_t - scale * (rotation * mu_e),
+    })
+}
+
+/// The rotation nearest (Frobenius) to the sum of the given ones.
+fn chordal_mean<'a>(rotations: impl Iterator<Item = &'a Rotation3<f64>>) -> Rotation3<f64> {
+    let sum: Matrix3<f64> = rotations.map(|r| r.matrix()).sum();
+    let svd = sum.svd(true, true);
+    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let mut d = Matrix3::identity();
+    if (u * v_t).determinant() < 0.0 {
+        // Flip the axis of the smallest singular value: the nearest proper rotation.
+        let sv = svd.singular_values;
+        let i = (0..3).min_by(|&a, &b| sv[a].total_cmp(&sv[b])).unwrap();
+        d[(i, i)] = -1.0;
+    }
+    Rotation3::from_matrix_unchecked(u * d * v_t)
 }
 
 /// Scene extent used to make error thresholds scale-free: the largest distance between two
@@ -162,10 +218,13 @@ pub fn rotation_error_deg(
     estimated: &Rotation3<f64>,
     truth: &Rotation3<f64>,
 ) -> f64 {
-    // atan2 of the relative quaternion: acos of the trace loses precision near zero.
-    let rel = UnitQuaternion::from_rotation_matrix(
-        &(truth.inverse() * estimated * sim.rotation.inverse()),
-    );
+    angle_deg(truth, &(estimated * sim.rotation.inverse()))
+}
+
+/// Angle in degrees between two rotations, by atan2 of the relative quaternion: acos of the
+/// trace (nalgebra's `angle_to`) loses precision near zero and can return NaN there.
+fn angle_deg(a: &Rotation3<f64>, b: &Rotation3<f64>) -> f64 {
+    let rel = UnitQuaternion::from_rotation_matrix(&(a.inverse() * b));
     (2.0 * rel.imag().norm().atan2(rel.w.abs())).to_degrees()
 }
 
@@ -176,7 +235,7 @@ pub struct Evaluation {
     pub missing: Vec<String>,
     /// Largest distance between two true camera centres.
     pub extent: f64,
-    /// Estimated -> true frame (robust fit, threshold 5% of the extent).
+    /// Estimated -> true frame ([`align_poses`] with the limits of a correct camera).
     pub similarity: Similarity,
     /// Per registered image: name, centre error (true units), rotation error (degrees).
     pub errors: Vec<(String, f64, f64)>,
@@ -193,8 +252,9 @@ impl Evaluation {
     }
 }
 
-/// Aligns `estimated` onto `truth` by camera centres ([`umeyama_ransac`]) and measures every
-/// registered image's errors.
+/// Aligns `estimated` onto `truth` by camera poses ([`align_poses`], with the limits that make a
+/// camera correct: 5% of the truth's extent, 5 degrees) and measures every registered image's
+/// errors.
 pub fn evaluate(estimated: &[ModelImage], truth: &[ModelImage]) -> Result<Evaluation> {
     let by_name: HashMap<&str, &ModelImage> =
         estimated.iter().map(|m| (m.name.as_str(), m)).collect();
@@ -206,22 +266,26 @@ pub fn evaluate(estimated: &[ModelImage], truth: &[ModelImage]) -> Result<Evalua
             None => missing.push(t.name.clone()),
         }
     }
-    let src: Vec<_> = pairs.iter().map(|(e, _)| e.centre()).collect();
-    let dst: Vec<_> = pairs.iter().map(|(_, t)| t.centre()).collect();
+    let pose = |m: &ModelImage| Pose {
+        rotation: m.rotation.to_rotation_matrix(),
+        centre: m.centre(),
+    };
+    let src: Vec<_> = pairs.iter().map(|(e, _)| pose(e)).collect();
+    let dst: Vec<_> = pairs.iter().map(|(_, t)| pose(t)).collect();
     let extent = scene_extent(&truth.iter().map(|t| t.centre()).collect::<Vec<_>>());
-    let (similarity, _) = umeyama_ransac(&src, &dst, 0.05 * extent, 200, 0)?;
+    let tolerance = Tolerance {
+        position: crate::eval::score::POSITION_TOLERANCE * extent,
+        rotation_deg: crate::eval::score::ROTATION_TOLERANCE_DEG,
+    };
+    let (similarity, _) = align_poses(&src, &dst, tolerance, 5000, 0)?;
     let errors = pairs
         .iter()
         .zip(src.iter().zip(&dst))
-        .map(|((e, t), (s, d))| {
+        .map(|((_, t), (s, d))| {
             (
                 t.name.clone(),
-                (similarity.apply(s) - d).norm(),
-                rotation_error_deg(
-                    &similarity,
-                    &e.rotation.to_rotation_matrix(),
-                    &t.rotation.to_rotation_matrix(),
-                ),
+                (similarity.apply(&s.centre) - d.centre).norm(),
+                rotation_error_deg(&similarity, &s.rotation, &d.rotation),
             )
         })
         .collect();
@@ -236,6 +300,7 @@ pub fn evaluate(estimated: &[ModelImage], truth: &[ModelImage]) -> Result<Evalua
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::UnitQuaternion;
     use rand::Rng;
 
     fn known() -> Similarity {
@@ -246,56 +311,156 @@ mod tests {
         }
     }
 
-    fn cloud(n: usize, seed: u64) -> Vec<Vector3<f64>> {
+    fn inverse(sim: &Similarity) -> Similarity {
+        let rotation = sim.rotation.inverse();
+        Similarity {
+            scale: 1.0 / sim.scale,
+            rotation,
+            translation: -(rotation * sim.translation) / sim.scale,
+        }
+    }
+
+    /// The pose in the frame `sim` maps into: x' = sim(x) moves the centre, and the camera
+    /// rotation becomes R sim.R^T.
+    fn moved(pose: &Pose, sim: &Similarity) -> Pose {
+        Pose {
+            rotation: pose.rotation * sim.rotation.inverse(),
+            centre: sim.apply(&pose.centre),
+        }
+    }
+
+    fn random_poses(n: usize, seed: u64) -> Vec<Pose> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         (0..n)
-            .map(|_| Vector3::new(rng.gen(), rng.gen(), rng.gen()) * 10.0)
+            .map(|_| Pose {
+                rotation: Rotation3::from_euler_angles(rng.gen(), rng.gen(), rng.gen()),
+                centre: Vector3::new(rng.gen(), rng.gen(), rng.gen()) * 10.0,
+            })
             .collect()
     }
+
+    const TOLERANCE: Tolerance = Tolerance {
+        position: 0.5,
+        rotation_deg: 5.0,
+    };
 
     #[test]
     fn recovers_known_similarity() {
         let sim = known();
-        let src = cloud(20, 1);
-        let dst: Vec<_> = src.iter().map(|p| sim.apply(p)).collect();
-        let fit = umeyama(&src, &dst).unwrap();
+        let truth = random_poses(20, 1);
+        let estimated: Vec<_> = truth.iter().map(|p| moved(p, &inverse(&sim))).collect();
+        let (fit, mask) = align_poses(&estimated, &truth, TOLERANCE, 5000, 0).unwrap();
+        assert!(mask.iter().all(|&m| m));
         assert!((fit.scale - sim.scale).abs() < 1e-9);
-        assert!(fit.rotation.angle_to(&sim.rotation) < 1e-9);
+        assert!(angle_deg(&fit.rotation, &sim.rotation) < 1e-9);
         assert!((fit.translation - sim.translation).norm() < 1e-8);
     }
 
     #[test]
-    fn reflection_is_not_returned() {
-        // Mirrored targets: the best proper rotation, never a reflection.
-        let src = cloud(10, 2);
-        let dst: Vec<_> = src.iter().map(|p| Vector3::new(-p.x, p.y, p.z)).collect();
-        let fit = umeyama(&src, &dst).unwrap();
-        assert!((fit.rotation.matrix().determinant() - 1.0).abs() < 1e-9);
-    }
-
-    #[test]
-    fn collinear_points_are_refused() {
-        let src: Vec<_> = (0..5).map(|i| Vector3::new(i as f64, 0.0, 0.0)).collect();
-        assert!(umeyama(&src, &src).is_err());
-    }
-
-    #[test]
-    fn robust_fit_survives_30_percent_outliers() {
+    fn robust_fit_survives_40_percent_outliers() {
         let sim = known();
-        let src = cloud(40, 3);
-        let mut dst: Vec<_> = src.iter().map(|p| sim.apply(p)).collect();
-        let mut rng = ChaCha8Rng::seed_from_u64(4);
-        for d in dst.iter_mut().take(12) {
-            *d += Vector3::new(rng.gen(), rng.gen(), rng.gen()) * 30.0 + Vector3::repeat(5.0);
-        }
-        let (fit, mask) = umeyama_ransac(&src, &dst, 0.1, 200, 7).unwrap();
+        let truth = random_poses(40, 3);
+        let mut estimated: Vec<_> = truth.iter().map(|p| moved(p, &inverse(&sim))).collect();
+        // 16 cameras anywhere, with any rotation; the sampled hypotheses (fewer than all 780
+        // pairs) still find the 24 consistent ones.
+        estimated[..16].copy_from_slice(&random_poses(16, 4));
+        let (fit, mask) = align_poses(&estimated, &truth, TOLERANCE, 300, 7).unwrap();
         assert!((fit.scale - sim.scale).abs() < 1e-6);
-        assert!(fit.rotation.angle_to(&sim.rotation) < 1e-6);
-        assert_eq!(mask.iter().filter(|&&m| m).count(), 28);
-        assert!(mask[..12].iter().all(|&m| !m));
-        // The plain fit is pulled away by the outliers.
-        let plain = umeyama(&src, &dst).unwrap();
-        assert!((plain.scale - sim.scale).abs() > 1e-3);
+        assert!(angle_deg(&fit.rotation, &sim.rotation) < 1e-6);
+        assert_eq!(mask.iter().filter(|&&m| m).count(), 24);
+        assert!(mask[..16].iter().all(|&m| !m));
+    }
+
+    #[test]
+    fn coinciding_centres_are_refused() {
+        let truth = random_poses(3, 5);
+        let estimated: Vec<_> = truth
+            .iter()
+            .map(|p| Pose {
+                rotation: p.rotation,
+                centre: Vector3::zeros(),
+            })
+            .collect();
+        assert!(align_poses(&estimated, &truth, TOLERANCE, 100, 0).is_err());
+    }
+
+    #[test]
+    fn chordal_mean_is_a_proper_rotation_near_its_inputs() {
+        let base = Rotation3::from_euler_angles(0.4, 0.1, -2.0);
+        let tilt = |a: f64| base * Rotation3::from_axis_angle(&Vector3::z_axis(), a);
+        let rs = [tilt(0.01), tilt(-0.01), tilt(0.02), tilt(-0.02)];
+        let mean = chordal_mean(rs.iter());
+        assert!((mean.matrix().determinant() - 1.0).abs() < 1e-9);
+        assert!(angle_deg(&mean, &base) < 1e-9);
+    }
+
+    /// The case that made centre-only alignment report 0 correct cameras: half the cameras are
+    /// right to 0.1 degree and lie on a line, the other half (a ghosted group) sit where a fit
+    /// tilted 30 degrees about that line puts every centre exactly on its true place. Only the
+    /// rotations tell the fits apart.
+    #[test]
+    fn a_tilted_fit_that_explains_every_centre_loses_to_the_rotations() {
+        let model = |name: String, p: &Pose| ModelImage {
+            image_id: 0,
+            camera_id: 1,
+            name,
+            rotation: UnitQuaternion::from_rotation_matrix(&p.rotation),
+            translation: -(p.rotation * p.centre),
+        };
+        let tilt = Similarity {
+            scale: 1.0,
+            rotation: Rotation3::from_axis_angle(&Vector3::x_axis(), 30f64.to_radians()),
+            translation: Vector3::zeros(),
+        };
+        let frame = known();
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let (mut truth, mut estimated) = (Vec::new(), Vec::new());
+        for k in 0..20 {
+            let on_line = k < 10;
+            let yaw = rng.gen_range(-0.3..0.3);
+            let t = Pose {
+                rotation: Rotation3::from_euler_angles(-1.5, 0.0, yaw),
+                centre: Vector3::new((k % 10) as f64, if on_line { 0.0 } else { 5.0 }, 0.0),
+            };
+            let e = if on_line {
+                // Right, with 0.1 degree of rotation noise.
+                let noise = Rotation3::from_axis_angle(
+                    &nalgebra::Unit::new_normalize(Vector3::new(rng.gen(), rng.gen(), rng.gen())),
+                    0.1f64.to_radians(),
+                );
+                Pose {
+                    rotation: t.rotation * noise,
+                    centre: t.centre,
+                }
+            } else {
+                // Ghosted: centre where the tilted fit explains it, rotation 20 degrees off
+                // under that fit too.
+                let ghost = moved(&t, &inverse(&tilt));
+                Pose {
+                    rotation: ghost.rotation
+                        * Rotation3::from_axis_angle(&Vector3::y_axis(), 20f64.to_radians()),
+                    centre: ghost.centre,
+                }
+            };
+            truth.push(model(format!("{k:02}"), &t));
+            estimated.push(model(format!("{k:02}"), &moved(&e, &inverse(&frame))));
+        }
+        // Centres cannot tell: the tilted fit puts all 20 exactly on the truth.
+        let tilted = |x: &Vector3<f64>| tilt.apply(&frame.apply(x));
+        for (e, t) in estimated.iter().zip(&truth) {
+            assert!((tilted(&e.centre()) - t.centre()).norm() < 1e-9);
+        }
+        let eval = evaluate(&estimated, &truth).unwrap();
+        let correct: Vec<&str> = eval
+            .errors
+            .iter()
+            .filter(|(_, p, r)| *p < 0.05 * eval.extent && *r < 5.0)
+            .map(|(name, _, _)| name.as_str())
+            .collect();
+        let expected: Vec<String> = (0..10).map(|k| format!("{k:02}")).collect();
+        assert_eq!(correct, expected);
+        assert!(angle_deg(&eval.similarity.rotation, &frame.rotation) < 0.1);
+        assert!(eval.errors[..10].iter().all(|e| e.2 < 0.2));
     }
 
     #[test]

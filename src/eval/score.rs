@@ -1,5 +1,6 @@
 //! Scoring a reconstruction against ground-truth poses: every sub-model is aligned to the truth by
-//! a robust similarity of camera centres; an image is correct when its centre is within 5% of the
+//! the similarity under which the most cameras are right in position and rotation
+//! ([`align::align_poses`]); an image is correct when its centre is within 5% of the
 //! truth's extent and its rotation within 5 degrees. A ghosted model (one copy's cameras
 //! registered onto the other) registers images that are not correct.
 
@@ -63,7 +64,7 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
     let mut best: HashMap<String, ImageScore> = HashMap::new();
     for (index, dir) in dirs.iter().enumerate() {
         let estimated = model::read_images(dir)?;
-        // A model of fewer than 3 known images cannot be aligned: its images stay unscored.
+        // A model of fewer than 2 known images cannot be aligned: its images stay unscored.
         let Ok(eval) = align::evaluate(&estimated, &truth) else {
             continue;
         };

@@ -3,7 +3,7 @@
 //!
 //! Tokens are separated by ASCII whitespace; CRLF line ends, trailing whitespace and blank lines
 //! after the last pair line are accepted. Anything else is an error naming the 1-based line.
-//! Duplicate pairs are not detected. [`write`] produces the format, round-tripping costs exactly.
+//! Duplicate pairs are not detected. [`write()`] produces the format, round-tripping costs exactly.
 
 use crate::network::{PairArc, SelectionProblem};
 use anyhow::{bail, Result};

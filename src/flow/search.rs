@@ -5,7 +5,7 @@
 //! exact smallest such F (the paper doubles F and bisects, with one full solve per probe).
 //!
 //! Targets, with n = number of images in the problem: images selected >= ceil(A n) and pairs
-//! selected >= min(ceil(B n), |E|).
+//! selected >= min(max(ceil(B n), ceil(P |E|)), |E|).
 //!
 //! When no F meets both targets the full graph is kept (`capped`): every image and every pair
 //! selected, including images without pairs. Its `flow` is |E| and its `cost` is that of the
@@ -36,18 +36,20 @@ pub enum FlowRule {
 
 impl FlowRule {
     /// A fixed flow when `flow` is set, else the criteria, each taken from `defaults` (image
-    /// fraction, pairs per image) where unset.
+    /// fraction, pairs per image, pair fraction) where unset.
     pub fn new(
         flow: Option<u64>,
         min_image_fraction: Option<f64>,
         min_pairs_per_image: Option<f64>,
-        defaults: (f64, f64),
+        min_pair_fraction: Option<f64>,
+        defaults: (f64, f64, f64),
     ) -> FlowRule {
         match flow {
             Some(f) => FlowRule::Fixed(f),
             None => FlowRule::Criteria(Criteria {
                 min_image_fraction: min_image_fraction.unwrap_or(defaults.0),
                 min_pairs_per_image: min_pairs_per_image.unwrap_or(defaults.1),
+                min_pair_fraction: min_pair_fraction.unwrap_or(defaults.2),
             }),
         }
     }
@@ -60,6 +62,9 @@ pub struct Criteria {
     pub min_image_fraction: f64,
     /// Selected pairs >= this x images in the view graph (capped at all pairs).
     pub min_pairs_per_image: f64,
+    /// ... and >= this share of all pairs: the paper's criterion for its dense lab scenes
+    /// (about 25% of the edges); 0 for the others.
+    pub min_pair_fraction: f64,
 }
 
 /// One criterion after the search: its target, what the chosen F reached, whether it was met.
@@ -107,8 +112,10 @@ pub struct SearchResult {
 pub fn targets(problem: &SelectionProblem, criteria: &Criteria) -> (usize, usize) {
     let n = problem.image_costs.len() as f64;
     let images = (criteria.min_image_fraction * n).ceil().max(0.0) as usize;
-    let pairs =
-        ((criteria.min_pairs_per_image * n).ceil().max(0.0) as usize).min(problem.pairs.len());
+    let m = problem.pairs.len();
+    let per_image = (criteria.min_pairs_per_image * n).ceil().max(0.0) as usize;
+    let fraction = (criteria.min_pair_fraction * m as f64).ceil().max(0.0) as usize;
+    let pairs = per_image.max(fraction).min(m);
     (images, pairs)
 }
 

@@ -61,6 +61,8 @@ pub struct Report {
     pub priors: Vec<PriorSummary>,
     /// The overrides applied, by name.
     pub overrides: Listed,
+    /// The order the network's pair arcs followed, and how sequential the selection is in it.
+    pub order: OrderReport,
     /// Files written besides the database: filled in by the command as it writes them.
     pub outputs: Outputs,
     /// Seconds per stage.
@@ -74,6 +76,22 @@ pub struct Outputs {
     pub pairs_out: Option<String>,
     /// The SVG plots written (`--plots`).
     pub plots: Vec<String>,
+}
+
+/// The order the pair arcs followed and how sequential the pairs are in it.
+#[derive(Debug, Serialize)]
+pub struct OrderReport {
+    /// Which order (`--order`).
+    pub name: crate::selection::capture_order::Order,
+    /// Share of the selected pairs whose images are at most `window` positions apart (null when
+    /// none is selected), and the same over the whole view graph for comparison.
+    pub selected_within_window: Option<f64>,
+    /// See `selected_within_window`.
+    pub view_graph_within_window: Option<f64>,
+    /// Positions apart that count as sequential.
+    pub window: u32,
+    /// With the `exif` order: images without a capture time (placed last, by name).
+    pub images_without_time: usize,
 }
 
 /// Spread of one prior's fitness over all images or pairs, and over the selected ones.
@@ -141,6 +159,17 @@ impl Report {
             &selection.pairs,
             "pairs",
         ));
+        let order = &plan.order;
+        let window = crate::selection::capture_order::SEQUENTIAL_WINDOW;
+        let share = |kept: Option<&[bool]>| {
+            let edges = plan.graph.edges.iter().enumerate();
+            order.share_within(
+                edges
+                    .filter(|(k, _)| kept.is_none_or(|kept| kept[*k]))
+                    .map(|(_, e)| (e.i, e.j)),
+                window,
+            )
+        };
         Report {
             schema_version: SCHEMA_VERSION,
             tool_version: env!("CARGO_PKG_VERSION"),
@@ -165,6 +194,13 @@ impl Report {
             criteria: plan.search.criteria.clone(),
             priors,
             overrides: plan.overrides.clone(),
+            order: OrderReport {
+                name: order.order,
+                selected_within_window: share(Some(&selection.pairs)),
+                view_graph_within_window: share(None),
+                window,
+                images_without_time: order.images_without_time,
+            },
             outputs: Outputs::default(),
             timings: plan.timings.clone(),
         }
@@ -209,6 +245,17 @@ impl Report {
                 ""
             }
         );
+        if let Some(share) = self.order.selected_within_window {
+            s += &format!(
+                "\npair arcs in {} order: {:.0}% of the selected pairs are within {} positions",
+                serde_json::to_value(self.order.name)
+                    .unwrap_or_default()
+                    .as_str()
+                    .unwrap_or(""),
+                100.0 * share,
+                self.order.window
+            );
+        }
         let o = &self.overrides;
         if !(o.keep_pairs.is_empty() && o.forbid_pairs.is_empty() && o.forbid_images.is_empty()) {
             s += &format!(

@@ -4,6 +4,7 @@
 
 use crate::costs::CostModel;
 use crate::flow::search::FlowRule;
+use crate::selection::capture_order::{self, Order};
 use crate::selection::pipeline::Options;
 use crate::selection::preset::Preset;
 use serde::{Deserialize, Serialize};
@@ -23,6 +24,15 @@ pub struct Parameters {
     pub min_image_fraction: Option<f64>,
     /// The search's pair criterion (None with a fixed flow).
     pub min_pairs_per_image: Option<f64>,
+    /// The search's share-of-pairs criterion (None with a fixed flow or in older records).
+    #[serde(default)]
+    pub min_pair_fraction: Option<f64>,
+    /// The order the network's pair arcs follow (image_id in older records).
+    #[serde(default)]
+    pub order: Order,
+    /// The image folder read for the `exif` order.
+    #[serde(default)]
+    pub image_path: Option<String>,
     /// The override files given (paths as given), for the record.
     pub keep_pairs: Option<String>,
     /// See `keep_pairs`.
@@ -34,7 +44,7 @@ pub struct Parameters {
 impl Parameters {
     /// A preset's parameters: its cost model and search criteria, no overrides.
     pub fn of_preset(preset: Preset, min_num_matches: usize) -> Parameters {
-        let (fraction, per_image) = preset.criteria();
+        let (fraction, per_image, pair_fraction) = preset.criteria();
         Parameters {
             preset,
             cost_model: preset.model(),
@@ -42,6 +52,9 @@ impl Parameters {
             flow: None,
             min_image_fraction: Some(fraction),
             min_pairs_per_image: Some(per_image),
+            min_pair_fraction: Some(pair_fraction),
+            order: Order::default(),
+            image_path: None,
             keep_pairs: None,
             forbid_pairs: None,
             forbid_images: None,
@@ -54,6 +67,7 @@ impl Parameters {
             self.flow,
             self.min_image_fraction,
             self.min_pairs_per_image,
+            self.min_pair_fraction,
             self.preset.criteria(),
         )
     }
@@ -66,6 +80,10 @@ impl Parameters {
             model: self.cost_model.clone(),
             unweighted_priors,
             curve_factor: 0,
+            capture: capture_order::Input {
+                order: self.order,
+                image_path: self.image_path.as_ref().map(Into::into),
+            },
         }
     }
 }

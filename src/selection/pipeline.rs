@@ -11,6 +11,7 @@ use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::Scene;
+use crate::selection::capture_order::{self, CaptureOrder};
 use crate::selection::overrides::{Listed, Overrides};
 use crate::selection::parameters::Parameters;
 use crate::selection::preset::Preset;
@@ -36,6 +37,8 @@ pub struct Options {
     pub unweighted_priors: bool,
     /// Continue the selection curve to this many times the chosen F (0: stop there), for plots.
     pub curve_factor: u64,
+    /// The order the network's pair arcs follow.
+    pub capture: capture_order::Input,
 }
 
 /// Seconds spent in each stage.
@@ -73,6 +76,8 @@ pub struct Plan {
     pub network: Restriction,
     /// The overrides applied, by name, for the report.
     pub overrides: Listed,
+    /// The order the pair arcs followed.
+    pub order: CaptureOrder,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
     pub search: SearchResult,
     /// The fitness floor applied (see [`fitness_floor`]).
@@ -115,8 +120,11 @@ pub fn last_plan(db: &Database, stage: &dyn Fn(&str)) -> Result<Plan> {
         Some(row) => row.run.parameters,
         None => Parameters::of_preset(Preset::General, DEFAULT_MIN_NUM_MATCHES),
     };
+    // No flow runs, so the order, which only orients the arcs, is image_id's: it needs no image
+    // files (an EXIF order would).
     let options = Options {
         rule: FlowRule::Fixed(0),
+        capture: Default::default(),
         ..parameters.options(true)
     };
     plan_with(db, &options, &Overrides::default(), stage)
@@ -150,6 +158,7 @@ pub fn plan_with(
     let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
     let names = options.model.pair_prior_names(options.unweighted_priors);
     let scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
+    let order = capture_order::compute(&options.capture, &graph, &images, &pairs)?;
     timings.read = started.elapsed().as_secs_f64();
 
     stage("computing priors");
@@ -169,10 +178,14 @@ pub fn plan_with(
             below_fitness_floor += 1;
         }
     }
-    let network = problem(&graph, &costs).restrict(&resolved.forbidden_vertices, &resolved.edges);
+    let network = problem(&graph, &costs, &order).restrict(
+        &order.by_rank(&resolved.forbidden_vertices),
+        &resolved.edges,
+    );
     let mut search =
         search::search_with_curve(&network.problem, &options.rule, options.curve_factor);
     search.selection = network.expand(&search.selection);
+    search.selection.images = order.by_vertex(&search.selection.images);
     timings.solve = t.elapsed().as_secs_f64();
 
     let invalidate = graph
@@ -193,6 +206,7 @@ pub fn plan_with(
         costs,
         network,
         overrides: resolved.listed,
+        order,
         search,
         fitness_floor: floor,
         below_fitness_floor,
@@ -202,19 +216,22 @@ pub fn plan_with(
     })
 }
 
-/// The paper's network on the whole view graph: vertices and edges in view-graph order (image_id
-/// order, which orients the pair arcs).
-fn problem(graph: &ViewGraph, costs: &Costs) -> SelectionProblem {
+/// The paper's network on the whole view graph: images indexed by their position in `order`
+/// (which orients the pair arcs, lower to higher), pair arcs in view-graph edge order.
+fn problem(graph: &ViewGraph, costs: &Costs, order: &CaptureOrder) -> SelectionProblem {
     SelectionProblem {
-        image_costs: costs.image_costs.clone(),
+        image_costs: order.by_rank(&costs.image_costs),
         pairs: graph
             .edges
             .iter()
             .zip(&costs.pair_costs)
-            .map(|(e, &cost)| PairArc {
-                i: e.i,
-                j: e.j,
-                cost,
+            .map(|(e, &cost)| {
+                let (a, b) = (order.rank[e.i as usize], order.rank[e.j as usize]);
+                PairArc {
+                    i: a.min(b),
+                    j: a.max(b),
+                    cost,
+                }
             })
             .collect(),
     }
@@ -331,6 +348,44 @@ mod tests {
     use crate::flow::search::Criteria;
     use crate::scene::testing::{images, pair};
 
+    /// The order decides what one unit of flow selects: on a triangle of equal costs the flow
+    /// takes the two pairs along the order and leaves the pair that skips the middle image.
+    #[test]
+    fn the_network_orients_its_arcs_by_the_capture_order() {
+        let images = images(3);
+        let pairs: Vec<VerifiedPair> = [(1, 2), (2, 3), (1, 3)]
+            .map(|(a, b)| pair(a, b, vec![[0, 0]; 50]))
+            .to_vec();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let costs = Costs {
+            image_costs: vec![0.0; 3],
+            pair_costs: vec![-1.0; 3],
+            image_fitness: Vec::new(),
+            pair_fitness: Vec::new(),
+        };
+        let skipped = |rank: Vec<u32>| {
+            let order = CaptureOrder {
+                order: capture_order::Order::Name,
+                rank,
+                images_without_time: 0,
+            };
+            let whole = problem(&graph, &costs, &order);
+            assert!(whole.pairs.iter().all(|p| p.i < p.j));
+            let selection = search::search(&whole, &FlowRule::Fixed(1)).selection;
+            let left: Vec<(u32, u32)> = graph
+                .edges
+                .iter()
+                .zip(&selection.pairs)
+                .filter(|(_, &kept)| !kept)
+                .map(|(e, _)| (graph.image_ids[e.i as usize], graph.image_ids[e.j as usize]))
+                .collect();
+            left
+        };
+        assert_eq!(skipped(vec![0, 1, 2]), [(1, 3)]);
+        assert_eq!(skipped(vec![0, 2, 1]), [(1, 2)]);
+        assert_eq!(skipped(vec![1, 0, 2]), [(2, 3)]);
+    }
+
     #[test]
     fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {
         // A path 1-2-3-4-5: pair fitnesses 0.9, 0.8, 0.2, 0.1.
@@ -345,11 +400,13 @@ mod tests {
                 None => FlowRule::Criteria(Criteria {
                     min_image_fraction: fraction,
                     min_pairs_per_image: per_image,
+                    min_pair_fraction: 0.0,
                 }),
             },
             model: CostModel::disambiguation(),
             unweighted_priors: false,
             curve_factor: 0,
+            capture: Default::default(),
         };
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already, and
         // half of 0.4 pairs per image x 5 images is one pair.

@@ -17,6 +17,12 @@ pub enum Preset {
     /// selected; the paper's context and multiple motions at weight 0 (in --scores). Search: 80%
     /// of images, 5 pairs per image.
     Disambiguation,
+    /// The paper's section 5.1 as written, for its lab scenes: context similarity, loop
+    /// consistency and multiple motions with uniform weights, no fitness floor; search: 25% of
+    /// the view graph's pairs (its lab criterion), no image criterion. Relies on the pair arcs
+    /// following the capture order (--order).
+    #[serde(rename = "paper-disambiguation")]
+    PaperDisambiguation,
 }
 
 impl Preset {
@@ -25,6 +31,7 @@ impl Preset {
         match self {
             Preset::General => "general",
             Preset::Disambiguation => "disambiguation",
+            Preset::PaperDisambiguation => "paper-disambiguation",
         }
     }
 
@@ -33,14 +40,16 @@ impl Preset {
         match self {
             Preset::General => CostModel::general(),
             Preset::Disambiguation => CostModel::disambiguation(),
+            Preset::PaperDisambiguation => CostModel::paper_disambiguation(),
         }
     }
 
-    /// The paper's flow-search criteria: (image fraction, pairs per image).
-    pub fn criteria(self) -> (f64, f64) {
+    /// The paper's flow-search criteria: (image fraction, pairs per image, pair fraction).
+    pub fn criteria(self) -> (f64, f64, f64) {
         match self {
-            Preset::General => (0.9, 20.0),
-            Preset::Disambiguation => (0.8, 5.0),
+            Preset::General => (0.9, 20.0, 0.0),
+            Preset::Disambiguation => (0.8, 5.0, 0.0),
+            Preset::PaperDisambiguation => (0.0, 0.0, 0.25),
         }
     }
 }

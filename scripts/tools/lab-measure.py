@@ -1,0 +1,236 @@
+#!/usr/bin/env python3
+"""Measurements on a lab photo set without published ground truth (docs/priors.md).
+
+usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit]
+           [--run PRESET:VARIANT[:ORDER] ...]
+
+  NAME      the set's name in the output
+  IMAGES    its image folder (file names sort in capture order)
+  WORK      output folder; every step is skipped when its output exists (delete to redo)
+  ORDER.db  the set's database with image ids in capture order (scripts/tools/build-db.sh)
+  VARIANT=DB  more databases of the same images, e.g. shuffled=shuffled1.db (ids in random order)
+  --orbit   the capture is a closed orbit (Cup): the sanity check asks the orbit to close
+  --run     a prune + `colmap mapper` run to score, e.g. paper-disambiguation:order or
+            paper-disambiguation:shuffled:graph (preset, variant, --order; default image_id)
+
+Steps:
+1. Pseudo ground truth: a copy of ORDER.db keeping only pairs at most 3 frames apart in file-name
+   order, reconstructed by `colmap mapper`. Sanity check: one model with every image; the camera
+   path has no jump (largest step <= 5 median steps); with --orbit the path turns once round its
+   centroid (300 to 420 degrees; a fold that merges the two sides of an object turns about twice
+   as far) and its first and last cameras are at most 5 median steps apart. `trusted` in
+   truth.json says whether the check passed.
+2. Pair labels per database: `vgsel-colmap eval --labels` under the pseudo ground truth (median
+   Sampson error of the inliers >= 4 px: false).
+3. Per-prior AUCs: `prune --dry_run --scores` (disambiguation preset, every prior computed; and
+   the paper-disambiguation preset's cost) joined with the labels by `vgsel-colmap separation`.
+4. Each --run: prune a copy, `colmap mapper`, `vgsel-colmap eval` against the pseudo ground truth
+   with the pair counts against the unpruned database.
+Writes WORK/results.json; prints it.
+"""
+import json
+import math
+import os
+import re
+import shutil
+import sqlite3
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+VGSEL = os.environ.get("VGSEL", os.path.join(ROOT, "target", "release", "vgsel-colmap"))
+WINDOW = 3
+
+
+def log(msg):
+    print(f"lab-measure: {msg}", file=sys.stderr, flush=True)
+
+
+def run(cmd, logfile=None):
+    out = subprocess.run(["nice", "-n", "5", *cmd], capture_output=True, text=True)
+    if logfile:
+        with open(logfile, "w") as f:
+            f.write(out.stdout + out.stderr)
+    if out.returncode != 0:
+        sys.exit(f"lab-measure: failed: {' '.join(cmd)}\n{out.stderr[-2000:]}")
+    return out.stdout
+
+
+def natural(name):
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
+
+
+def mapper(db, images, out):
+    """`colmap mapper` into out/ (sub-models out/0, out/1, ...), unless done before."""
+    if os.path.exists(out + ".done"):
+        return
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(out)
+    log(f"colmap mapper {db}")
+    run(["colmap", "mapper", "--database_path", db, "--image_path", images, "--output_path", out,
+         "--Mapper.extract_colors", "0"], out + ".log")
+    open(out + ".done", "w").close()
+
+
+def sequential_copy(db, out):
+    """A copy of db keeping only the verified pairs at most WINDOW frames apart by name."""
+    tmp = out + ".tmp"
+    shutil.copyfile(db, tmp)
+    con = sqlite3.connect(tmp)
+    names = dict(con.execute("SELECT image_id, name FROM images"))
+    rank = {i: k for k, i in enumerate(sorted(names, key=lambda i: natural(names[i])))}
+    far = []
+    for (pid,) in con.execute("SELECT pair_id FROM two_view_geometries"):
+        a, b = divmod(pid, 2147483647)
+        if abs(rank[a] - rank[b]) > WINDOW:
+            far.append((pid,))
+    con.executemany("DELETE FROM two_view_geometries WHERE pair_id = ?", far)
+    con.commit()
+    con.close()
+    os.replace(tmp, out)
+
+
+def centres(model_txt):
+    """name -> camera centre of a COLMAP text model."""
+    out = {}
+    lines = [l for l in open(os.path.join(model_txt, "images.txt")) if not l.startswith("#")]
+    for line in lines[::2]:
+        t = line.split()
+        qw, qx, qy, qz, tx, ty, tz = map(float, t[1:8])
+        # R^T t with R from the quaternion (world to camera); centre = -R^T t.
+        r = [[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+             [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+             [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]]
+        out[" ".join(t[9:])] = [-sum(r[i][j] * (tx, ty, tz)[i] for i in range(3)) for j in range(3)]
+    return out
+
+
+def sweep_deg(points):
+    """Signed angle the path turns round its centroid, about the mean normal of its steps."""
+    sub = lambda a, b: [x - y for x, y in zip(a, b)]
+    cross = lambda a, b: [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                          a[0] * b[1] - a[1] * b[0]]
+    dot = lambda a, b: sum(x * y for x, y in zip(a, b))
+    centroid = [sum(p[i] for p in points) / len(points) for i in range(3)]
+    rel = [sub(p, centroid) for p in points]
+    normal = [0.0, 0.0, 0.0]
+    for a, b in zip(rel, rel[1:]):
+        normal = [x + y for x, y in zip(normal, cross(a, b))]
+    length = math.sqrt(dot(normal, normal)) or 1.0
+    return math.degrees(sum(math.atan2(dot(cross(a, b), normal) / length, dot(a, b))
+                            for a, b in zip(rel, rel[1:])))
+
+
+def truth(images, order_db, work, orbit):
+    path = os.path.join(work, "truth.json")
+    if os.path.exists(path):
+        return json.load(open(path))
+    seq_db = os.path.join(work, "sequential.db")
+    if not os.path.exists(seq_db):
+        sequential_copy(order_db, seq_db)
+    sparse = os.path.join(work, "sequential")
+    mapper(seq_db, images, sparse)
+    models = sorted(d for d in os.listdir(sparse) if d.isdigit())
+    txt = os.path.join(work, "truth_txt")
+    os.makedirs(txt, exist_ok=True)
+    run(["colmap", "model_converter", "--input_path", os.path.join(sparse, "0"),
+         "--output_path", txt, "--output_type", "TXT"])
+    total = len(os.listdir(images))
+    c = centres(txt)
+    seq = sorted(c, key=natural)
+    dist = lambda a, b: math.dist(c[a], c[b])
+    steps = sorted(dist(a, b) for a, b in zip(seq, seq[1:]))
+    median = steps[len(steps) // 2]
+    result = {"models": len(models), "registered": len(c), "images": total,
+              "largest_step_over_median": steps[-1] / median,
+              "first_last_over_median": dist(seq[0], seq[-1]) / median,
+              "sweep_deg": sweep_deg([c[n] for n in seq])}
+    # A fold or a wrong link shows as a jump; an orbit must come back to its start.
+    result["trusted"] = (len(models) == 1 and len(c) == total
+                         and result["largest_step_over_median"] <= 5
+                         and (not orbit or (300 <= abs(result["sweep_deg"]) <= 420
+                                            and result["first_last_over_median"] <= 5)))
+    json.dump(result, open(path, "w"), indent=1)
+    return result
+
+
+def labels(db, work, variant):
+    path = os.path.join(work, f"labels_{variant}.csv")
+    if not os.path.exists(path):
+        txt = os.path.join(work, "truth_txt")
+        run([VGSEL, "eval", "--model", txt, "--ground_truth", txt, "--database_path", db,
+             "--labels", path])
+    return path
+
+
+def aucs(db, work, variant):
+    """Per-column AUCs (`vgsel-colmap separation`) of the disambiguation preset's scores, plus the
+    paper-disambiguation preset's cost as `paper_cost`."""
+    lab = labels(db, work, variant)
+    out = {}
+    for preset, rename in [("disambiguation", {}), ("paper-disambiguation", {"cost": "paper_cost"})]:
+        scores = os.path.join(work, f"scores_{preset}_{variant}.csv")
+        if not os.path.exists(scores):
+            run([VGSEL, "prune", "-q", "--database_path", db, "--dry_run", "--preset", preset,
+                 "--scores", scores])
+        text = run([VGSEL, "separation", "--scores", scores, "--labels", lab])
+        for line in text.splitlines():
+            m = re.match(r"(\d+) labelled pairs: (\d+) true, (\d+) false", line)
+            if m:
+                out["true"], out["false"] = int(m.group(2)), int(m.group(3))
+            t = line.split()
+            if len(t) == 3 and re.match(r"^-?\d\.\d{3}$|^(nan|NaN)$", t[1]):
+                if preset == "disambiguation" or t[0] in rename:
+                    out[rename.get(t[0], t[0])] = float(t[1])
+    return out
+
+
+def scored_run(images, work, dbs, spec):
+    preset, variant, *order = spec.split(":")
+    order = order[0] if order else "image_id"
+    tag = f"{preset}_{variant}_{order}"
+    path = os.path.join(work, f"run_{tag}.json")
+    if os.path.exists(path):
+        return json.load(open(path))
+    db = dbs[variant]
+    pruned = os.path.join(work, f"pruned_{tag}.db")
+    report = os.path.join(work, f"prune_{tag}.json")
+    if not os.path.exists(report):
+        run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
+             "--preset", preset, "--order", order, "--report", report])
+    sparse = os.path.join(work, f"sparse_{tag}")
+    mapper(pruned, images, sparse)
+    txt = os.path.join(work, "truth_txt")
+    e = json.loads(run([VGSEL, "eval", "--model", sparse, "--ground_truth", txt,
+                        "--database_path", pruned, "--baseline", db]))
+    r = json.load(open(report))
+    result = {"preset": preset, "variant": variant, "order": order, "flow": r["flow"],
+              "pairs_total": r["pairs_total"], "pairs_selected": r["pairs_selected"],
+              "within_5": r["order"]["selected_within_window"],
+              "models": e["models"], "registered": e["registered"], "correct": e["correct"],
+              "images": e["images_ground_truth"], "false_kept": e["pairs"]["false"],
+              "false_total": e["pairs"]["baseline"]["false"]}
+    json.dump(result, open(path, "w"), indent=1)
+    return result
+
+
+def main(argv):
+    orbit = "--orbit" in argv
+    argv = [a for a in argv if a != "--orbit"]
+    runs = [argv[k + 1] for k, a in enumerate(argv) if a == "--run"]
+    argv = [a for k, a in enumerate(argv) if a != "--run" and (k == 0 or argv[k - 1] != "--run")]
+    if len(argv) < 4:
+        sys.exit(__doc__)
+    name, images, work, order_db, *more = argv
+    os.makedirs(work, exist_ok=True)
+    dbs = {"order": order_db, **dict(m.split("=", 1) for m in more)}
+    result = {"set": name, "truth": truth(images, order_db, work, orbit)}
+    result["auc"] = {v: aucs(db, work, v) for v, db in dbs.items()}
+    result["runs"] = [scored_run(images, work, dbs, spec) for spec in runs]
+    json.dump(result, open(os.path.join(work, "results.json"), "w"), indent=1)
+    print(json.dumps(result, indent=1))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
