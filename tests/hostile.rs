@@ -10,7 +10,7 @@ use rusqlite::{params, Connection};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use tempfile::TempDir;
-use vgsel_colmap::colmap::ids::{pair_id, MAX_NUM_IMAGES};
+use vgsel_colmap::colmap::ids::{pair_id, TwoViewConfig, MAX_NUM_IMAGES};
 use vgsel_colmap::eval::synth::{generate, SceneSpec};
 
 /// Far above the ~0.5 s a prune of these 12-image databases takes (debug build, shared machine).
@@ -557,7 +557,7 @@ fn pose_and_focal_computations_are_bounded_on_non_finite_matrices() {
             let mut points = a.clone();
             points[3] = [x, 0.0];
             pair_pose(&StoredGeometry {
-                config: 4,
+                config: TwoViewConfig::Planar.code(),
                 e: Some(m),
                 f: Some(m),
                 h: Some(m),

@@ -4,6 +4,7 @@ use nalgebra::{Matrix3, Vector3};
 use rusqlite::{Connection, OptionalExtension};
 use std::collections::HashSet;
 use std::path::Path;
+use vgsel_colmap::colmap::ids::TwoViewConfig;
 use vgsel_colmap::colmap::model::read_images;
 use vgsel_colmap::eval::align::evaluate;
 use vgsel_colmap::eval::synth::{generate, pair_geometry, write_gt_model, GroundTruth, SceneSpec};
@@ -208,14 +209,14 @@ fn database_has_colmap_38_layout_and_consistent_blobs() {
     for row in tvg_rows(&conn) {
         assert_eq!(row.cols, 2);
         if row.rows == 0 {
-            assert_eq!(row.config, 0);
+            assert_eq!(row.config, TwoViewConfig::Undefined.code() as i64);
             assert!(row.data.is_none() && row.f.is_none() && row.e.is_none());
             assert!(row.h.is_none() && row.qvec.is_none() && row.tvec.is_none());
             continue;
         }
         verified += 1;
         assert!(row.rows >= spec.min_num_inliers);
-        assert_eq!(row.config, 2);
+        assert_eq!(row.config, TwoViewConfig::Calibrated.code() as i64);
         let data = row.data.unwrap();
         assert_eq!(data.len(), row.rows * 8);
         for blob in [&row.f, &row.e, &row.h] {

@@ -340,11 +340,8 @@ mod tests {
             .collect();
         let pairs = pairs
             .iter()
-            .map(|&(a, b, inliers)| VerifiedPair {
-                image_id1: a.min(b),
-                image_id2: a.max(b),
-                config: 2,
-                inliers: vec![[0, 0]; inliers],
+            .map(|&(a, b, inliers)| {
+                crate::scene::testing::pair(a.min(b), a.max(b), vec![[0, 0]; inliers])
             })
             .collect();
         (images, pairs)
