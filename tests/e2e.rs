@@ -60,7 +60,10 @@ fn rendered_duplicate_scene_through_colmap() {
     assert_eq!(n(&summary["prune"], "images_selected"), 20);
     assert_eq!(n(pairs, "true_graph_components"), 1, "{pairs}");
     assert_eq!(n(pruned, "registered"), 20, "{pruned}");
-    assert!(n(pruned, "correct") > n(full, "correct"), "{pruned} vs {full}");
+    assert!(
+        n(pruned, "correct") > n(full, "correct"),
+        "{pruned} vs {full}"
+    );
 }
 
 #[test]
