@@ -7,7 +7,6 @@ use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use vgsel_colmap::colmap::database::Database;
-use vgsel_colmap::colmap::rewrite;
 use vgsel_colmap::outputs::export;
 use vgsel_colmap::selection::pipeline;
 
@@ -27,7 +26,7 @@ pub fn run(args: &ExportArgs, quiet: bool, progress: &Progress) -> Result<()> {
     let db = Database::open_read_only(&args.database.database_path)?;
     let stage = |s: &str| progress.stage(s);
     let plan = pipeline::last_plan(&db, &stage)?;
-    let removed = rewrite::invalidated_pairs(&db)?;
+    let removed = db.invalidated_pair_ids()?;
     let (text, counts) = export::export(&plan, &removed, args.format);
     std::fs::write(&args.output, text)
         .with_context(|| format!("cannot write {}", args.output.display()))?;

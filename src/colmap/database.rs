@@ -380,13 +380,27 @@ impl Database {
     /// pair_id of every two_view_geometries row with at least `min_rows` inliers now (a pruned
     /// row has rows = 0): the pairs `colmap mapper --Mapper.min_num_matches` would use.
     pub fn used_pair_ids(&self, min_rows: usize) -> Result<HashSet<u64>> {
+        self.pair_ids(
+            "SELECT pair_id FROM two_view_geometries WHERE rows >= ?1",
+            [min_rows as i64],
+        )
+    }
+
+    /// pair_ids of the pairs a prune invalidated (their original rows are in the backup table);
+    /// empty when the database was never pruned.
+    pub fn invalidated_pair_ids(&self) -> Result<HashSet<u64>> {
+        if !self.has_backup_table()? {
+            return Ok(HashSet::new());
+        }
+        self.pair_ids("SELECT pair_id FROM vgsel_backup", [])
+    }
+
+    /// The pair_id column of a query's rows.
+    fn pair_ids(&self, sql: &str, params: impl rusqlite::Params) -> Result<HashSet<u64>> {
         let p = &self.path;
-        let mut stmt = self
-            .conn
-            .prepare("SELECT pair_id FROM two_view_geometries WHERE rows >= ?1")
-            .sql(p)?;
+        let mut stmt = self.conn.prepare(sql).sql(p)?;
         let ids = stmt
-            .query_map([min_rows as i64], |r| r.get::<_, i64>(0))
+            .query_map(params, |r| r.get::<_, i64>(0))
             .sql(p)?
             .map(|r| r.map(|id| id as u64))
             .collect::<Result<_, _>>()

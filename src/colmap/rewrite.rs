@@ -15,7 +15,7 @@ use anyhow::{anyhow, bail, Result};
 use rusqlite::{Connection, Transaction, TransactionBehavior};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use std::collections::{BTreeSet, HashSet};
+use std::collections::BTreeSet;
 use std::path::Path;
 
 /// The project's tables (CREATE TABLE IF NOT EXISTS).
@@ -266,25 +266,6 @@ pub fn restore(db: &mut Database) -> Result<usize> {
             .sql(p)?;
         Ok(n)
     })
-}
-
-/// pair_ids of the pairs the database's prune invalidated (their original rows are backed up);
-/// empty when it was never pruned.
-pub fn invalidated_pairs(db: &Database) -> Result<HashSet<u64>> {
-    if !db.has_backup_table()? {
-        return Ok(HashSet::new());
-    }
-    let p = db.path();
-    let mut stmt = db
-        .conn()
-        .prepare("SELECT pair_id FROM vgsel_backup")
-        .sql(p)?;
-    let ids = stmt
-        .query_map([], |r| r.get::<_, i64>(0))
-        .sql(p)?
-        .collect::<rusqlite::Result<Vec<_>>>()
-        .sql(p)?;
-    Ok(ids.into_iter().map(|id| id as u64).collect())
 }
 
 /// The most recent prune's record, or None when the database has no runs table (never pruned,

@@ -4,7 +4,7 @@
 //! `export` formats the plan of the database's last prune
 //! ([`crate::selection::pipeline::last_plan`]: its priors and costs recomputed with the recorded
 //! parameters, so they are the ones that drove the selection) with kept/removed as the database
-//! records it ([`crate::colmap::rewrite::invalidated_pairs`]).
+//! records it ([`crate::colmap::database::Database::invalidated_pair_ids`]).
 
 use crate::colmap::ids::pair_id;
 use crate::selection::pipeline::Plan;

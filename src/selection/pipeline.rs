@@ -114,7 +114,7 @@ pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Pl
 /// The plan of the database's last prune, recomputed from its recorded parameters (the general
 /// preset's when it was never pruned), without running a flow: its priors and costs are the ones
 /// that drove that selection. Which pairs were kept is the database's to say
-/// ([`crate::colmap::rewrite::invalidated_pairs`]).
+/// ([`crate::colmap::database::Database::invalidated_pair_ids`]).
 pub fn last_plan(db: &Database, stage: &dyn Fn(&str)) -> Result<Plan> {
     let parameters = match rewrite::last_run::<Parameters>(db)? {
         Some(row) => row.run.parameters,
