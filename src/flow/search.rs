@@ -161,16 +161,60 @@ pub fn search_with_curve(problem: &SelectionProblem, rule: &FlowRule, factor: u6
     let mut solver = ParametricSolver::new(problem);
     let mut result = run(&mut solver, problem, rule);
     if factor > 0 {
-        let chosen = result.selection.flow.max(1);
-        let limit = (factor * chosen).min(2 * problem.pairs.len() as u64);
-        let all_pairs = |solver: &ParametricSolver| {
-            solver.pairs_selected() == problem.pairs.len() && solver.flow() >= chosen
-        };
-        while !all_pairs(&solver) && solver.flow() < limit && solver.augment().is_some() {
+        let end = CurveEnd::new(problem, &result, factor);
+        while !end.complete(&point(&solver))
+            && solver.flow() < end.limit
+            && solver.augment().is_some()
+        {
             result.beyond.push(point(&solver));
         }
     }
     result
+}
+
+/// Where a selection curve continued past the chosen F ends: at `factor` times that F (at most
+/// 2|E|), or at the first point from the chosen F on that selects every pair.
+struct CurveEnd {
+    chosen: u64,
+    limit: u64,
+    pairs: usize,
+}
+
+impl CurveEnd {
+    fn new(problem: &SelectionProblem, result: &SearchResult, factor: u64) -> CurveEnd {
+        let chosen = result.selection.flow.max(1);
+        CurveEnd {
+            chosen,
+            limit: (factor * chosen).min(2 * problem.pairs.len() as u64),
+            pairs: problem.pairs.len(),
+        }
+    }
+
+    fn complete(&self, p: &CurvePoint) -> bool {
+        p.pairs_selected == self.pairs && p.flow >= self.chosen
+    }
+}
+
+impl SearchResult {
+    /// The curve from F = 1 to where [`search_with_curve`] with `factor` stops it (the recorded
+    /// curve and `beyond`, cut there: a capped search may have examined more).
+    pub fn curve_to(&self, problem: &SelectionProblem, factor: u64) -> Vec<CurvePoint> {
+        let end = CurveEnd::new(problem, self, factor);
+        let mut points = Vec::new();
+        for p in self.curve.iter().chain(&self.beyond) {
+            if p.flow == 0 {
+                continue;
+            }
+            if p.flow > end.limit {
+                break;
+            }
+            points.push(*p);
+            if end.complete(p) {
+                break;
+            }
+        }
+        points
+    }
 }
 
 fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {

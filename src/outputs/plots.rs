@@ -33,28 +33,19 @@ pub fn curve_points(plan: &Plan) -> Vec<Point> {
     let problem = &plan.network.problem;
     let images = problem.image_costs.len().max(1) as f64;
     let pairs = problem.pairs.len().max(1) as f64;
-    let chosen = plan.search.selection.flow.max(1);
-    let limit = (CURVE_FACTOR * chosen).min(2 * problem.pairs.len() as u64);
-    let mut points = Vec::new();
-    for p in plan.search.curve.iter().chain(&plan.search.beyond) {
-        if p.flow == 0 {
-            continue;
-        }
-        if p.flow > limit {
-            break;
-        }
-        points.push((
-            p.flow,
-            [
-                p.images_selected as f64 / images,
-                p.pairs_selected as f64 / pairs,
-            ],
-        ));
-        if p.pairs_selected == problem.pairs.len() && p.flow >= chosen {
-            break;
-        }
-    }
-    points
+    plan.search
+        .curve_to(problem, CURVE_FACTOR)
+        .iter()
+        .map(|p| {
+            (
+                p.flow,
+                [
+                    p.images_selected as f64 / images,
+                    p.pairs_selected as f64 / pairs,
+                ],
+            )
+        })
+        .collect()
 }
 
 fn plot_error<E: std::fmt::Debug>(path: &Path) -> impl FnOnce(E) -> anyhow::Error + '_ {
