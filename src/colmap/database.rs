@@ -133,6 +133,12 @@ pub(crate) fn sql_error(path: &Path, err: rusqlite::Error) -> anyhow::Error {
     }
 }
 
+/// [`Database::data_version`] on any connection to the file at `path` (a write transaction's too).
+pub(crate) fn data_version(conn: &Connection, path: &Path) -> Result<i64> {
+    conn.pragma_query_value(None, "data_version", |r| r.get(0))
+        .sql(path)
+}
+
 /// `rusqlite::Result` -> `anyhow::Result` with [`sql_error`]'s wording.
 pub(crate) trait SqlResult<T> {
     fn sql(self, path: &Path) -> Result<T>;
@@ -241,13 +247,13 @@ impl Database {
     pub fn set_busy_timeout(&self, timeout: Duration) -> Result<()> {
         self.conn.busy_timeout(timeout).sql(&self.path)
     }
+
     /// SQLite's `PRAGMA data_version`: changes exactly when another connection (this process
     /// or another) commits a change to the file, in rollback-journal and WAL mode alike.
     pub fn data_version(&self) -> Result<i64> {
-        self.conn
-            .pragma_query_value(None, "data_version", |r| r.get(0))
-            .sql(&self.path)
+        data_version(&self.conn, &self.path)
     }
+
     pub(crate) fn conn(&self) -> &Connection {
         &self.conn
     }

@@ -7,7 +7,7 @@
 //! `vgsel_backup` (sql/vgsel.sql), whose untyped columns keep each value's storage class, so a
 //! restore is byte for byte.
 
-use crate::colmap::database::{Database, SqlResult};
+use crate::colmap::database::{data_version, Database, SqlResult};
 use crate::colmap::ids::{image_ids, TwoViewConfig};
 use crate::colmap::migration;
 use crate::colmap::schema::{table_exists, TWO_VIEW_COLUMNS};
@@ -134,10 +134,7 @@ fn apply_checked<P: Serialize>(
 /// Fails (one line) when another connection committed a change since `PRAGMA data_version` was
 /// `read_version`.
 pub(crate) fn unchanged_since(conn: &Connection, p: &Path, read_version: i64) -> Result<()> {
-    let now: i64 = conn
-        .pragma_query_value(None, "data_version", |r| r.get(0))
-        .sql(p)?;
-    if now != read_version {
+    if data_version(conn, p)? != read_version {
         bail!(
             "{}: another program changed the database while it was being read; nothing was written (run the prune again)",
             p.display()
