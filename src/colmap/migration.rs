@@ -14,6 +14,8 @@
 use rusqlite::types::ValueRef;
 use rusqlite::{Connection, OptionalExtension};
 
+use super::schema::{column_names, user_version};
+
 /// `MakeDatabaseVersionNumber(3, 13, 0, 0)`: databases at or below it get the pose step.
 const POSE_PLACEHOLDERS_UP_TO: i64 = 3_130_000;
 /// `MakeDatabaseVersionNumber(3, 14, 0, 0)`: databases at or below it get the F/E/H step.
@@ -106,11 +108,6 @@ pub fn migrate_backup(conn: &Connection, from: i64, to: i64) -> rusqlite::Result
     Ok(updates.len())
 }
 
-/// `PRAGMA user_version` now (read inside the caller's transaction).
-pub fn user_version(conn: &Connection) -> rusqlite::Result<i64> {
-    conn.pragma_query_value(None, "user_version", |r| r.get(0))
-}
-
 /// Adds `vgsel_runs.user_version` to a runs table made by a vgsel-colmap that did not record it.
 pub fn ensure_version_column(conn: &Connection) -> rusqlite::Result<()> {
     if !has_version_column(conn)? {
@@ -120,11 +117,9 @@ pub fn ensure_version_column(conn: &Connection) -> rusqlite::Result<()> {
 }
 
 fn has_version_column(conn: &Connection) -> rusqlite::Result<bool> {
-    conn.query_row(
-        "SELECT EXISTS (SELECT 1 FROM pragma_table_info('vgsel_runs') WHERE name = 'user_version')",
-        [],
-        |r| r.get(0),
-    )
+    Ok(column_names(conn, "vgsel_runs")?
+        .iter()
+        .any(|c| c == "user_version"))
 }
 
 /// The schema version the backup rows were taken at: the last run's `user_version`. 0 (older

@@ -10,7 +10,7 @@
 use crate::colmap::database::{data_version, Database, SqlResult};
 use crate::colmap::ids::{image_ids, TwoViewConfig};
 use crate::colmap::migration;
-use crate::colmap::schema::{table_exists, TWO_VIEW_COLUMNS};
+use crate::colmap::schema::{self, table_exists, TWO_VIEW_COLUMNS};
 use anyhow::{anyhow, bail, Result};
 use rusqlite::{Connection, Transaction, TransactionBehavior};
 use serde::de::DeserializeOwned;
@@ -244,7 +244,7 @@ fn apply_in<P>(
             count(run.images_selected),
             count(run.pairs_total),
             count(run.pairs_selected),
-            migration::user_version(tx).sql(p)?,
+            schema::user_version(tx).sql(p)?,
         ],
     )
     .sql(p)?;

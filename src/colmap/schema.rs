@@ -62,15 +62,20 @@ pub(crate) fn table_exists(conn: &Connection, name: &str) -> rusqlite::Result<bo
     .map(|o| o.is_some())
 }
 
-fn column_names(conn: &Connection, table: &str) -> rusqlite::Result<Vec<String>> {
+pub(crate) fn column_names(conn: &Connection, table: &str) -> rusqlite::Result<Vec<String>> {
     let mut stmt = conn.prepare(&format!("PRAGMA table_info({table})"))?;
     let names = stmt.query_map([], |r| r.get::<_, String>(1))?;
     names.collect()
 }
 
+/// `PRAGMA user_version` now (inside a caller's transaction too).
+pub(crate) fn user_version(conn: &Connection) -> rusqlite::Result<i64> {
+    conn.pragma_query_value(None, "user_version", |r| r.get(0))
+}
+
 /// Reads user_version and the tables' columns; refuses what is not (or not yet) COLMAP.
 pub(crate) fn detect_layout(conn: &Connection) -> Result<Layout> {
-    let user_version: i64 = conn.pragma_query_value(None, "user_version", |r| r.get(0))?;
+    let user_version = user_version(conn)?;
     let mut stmt = conn.prepare("SELECT name FROM sqlite_master WHERE type = 'table'")?;
     let tables: HashSet<String> = stmt
         .query_map([], |r| r.get::<_, String>(0))?
