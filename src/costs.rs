@@ -198,6 +198,7 @@ impl CostModel {
                 prior("loop", Trapezoid::RISE, 0.0),
                 prior("loop_fraction", Trapezoid::FRACTION, 1.0),
                 prior("unique_tracks", Trapezoid::FRACTION, 1.0),
+                prior("backbone_tracks", Trapezoid::FRACTION, 0.0),
                 prior("motion_rotation", Trapezoid::MOTION_ROTATION, 0.0),
                 prior("motion_position", Trapezoid::MOTION_POSITION, 0.0),
             ],

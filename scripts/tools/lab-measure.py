@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Measurements on a lab photo set without published ground truth (docs/priors.md).
 
-usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit]
+usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
            [--run PRESET:VARIANT[:ORDER] ...]
 
   NAME      the set's name in the output
@@ -10,6 +10,8 @@ usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [
   ORDER.db  the set's database with image ids in capture order (scripts/tools/build-db.sh)
   VARIANT=DB  more databases of the same images, e.g. shuffled=shuffled1.db (ids in random order)
   --orbit   the capture is a closed orbit (Cup): the sanity check asks the orbit to close
+  --window  the sequential graph's reach in frames [3]; more bridges the jumps of a capture that
+            is only roughly a sequence (Oats, Cereal), at the risk of a false pair in it
   --run     a prune + `colmap mapper` run to score, e.g. paper-disambiguation:order or
             paper-disambiguation:shuffled:graph (preset, variant, --order; default image_id)
 
@@ -216,8 +218,13 @@ def scored_run(images, work, dbs, spec):
 
 
 def main(argv):
+    global WINDOW
     orbit = "--orbit" in argv
     argv = [a for a in argv if a != "--orbit"]
+    if "--window" in argv:
+        k = argv.index("--window")
+        WINDOW = int(argv[k + 1])
+        del argv[k:k + 2]
     runs = [argv[k + 1] for k, a in enumerate(argv) if a == "--run"]
     argv = [a for k, a in enumerate(argv) if a != "--run" and (k == 0 or argv[k - 1] != "--run")]
     if len(argv) < 4:

@@ -8,6 +8,7 @@
 //! and unique tracks (beyond the paper).
 //! [`pairs::compute`] computes the pair priors a cost model names.
 
+pub mod backbone_tracks;
 pub mod clustering;
 pub mod context;
 pub mod degree;
@@ -18,6 +19,7 @@ pub mod multiple_motions;
 pub mod overlap;
 pub mod pairs;
 pub mod track_fraction;
+pub mod tracks;
 pub mod triangulation_angle;
 pub mod unique_tracks;
 

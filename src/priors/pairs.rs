@@ -2,8 +2,8 @@
 //! cameras, focal-length estimation and a relative pose per pair; multiple motions also need the
 //! raw matches. [`needs`] tells the pipeline which of those to load into the [`Scene`].
 
+use super::{backbone_tracks, triangulation_angle, unique_tracks, PriorValues};
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
-use super::{triangulation_angle, unique_tracks, PriorValues};
 use crate::geometry::camera::CameraModel;
 use crate::geometry::focal::{self, FundamentalPair};
 use crate::geometry::view_geometry::{self, ViewGeometry};
@@ -74,6 +74,10 @@ pub fn compute(scene: &Scene, names: &[&str], stage: &dyn Fn(&str)) -> Result<Pa
     if wants("unique_tracks") {
         stage("following tracks");
         values.push(unique_tracks::compute(scene));
+    }
+    if wants("backbone_tracks") {
+        stage("following tracks through the backbone");
+        values.push(backbone_tracks::compute(scene));
     }
     if names.iter().any(|n| n.starts_with("context")) {
         stage("computing context similarity");

@@ -10,56 +10,30 @@
 //! follows how densely the scene was photographed). Measured on the rendered duplicate scenes
 //! (docs/priors.md): factor 4 separates better than 2 or 3 and as well as a smooth 1/length.
 
+use super::tracks::Tracks;
 use super::PriorValues;
 use crate::scene::Scene;
-use petgraph::unionfind::UnionFind;
 
 /// A track with more observations than this many times the median is confusing.
 pub const CONFUSING_FACTOR: u32 = 4;
 
 /// Share in [0, 1] of each edge's inliers on tracks that are not confusing (0 without inliers).
 pub fn compute(scene: &Scene) -> PriorValues {
-    let graph = scene.graph;
-    // One union-find element per keypoint of every vertex.
-    let mut offset = Vec::with_capacity(scene.keypoints.len() + 1);
-    offset.push(0usize);
-    for k in &scene.keypoints {
-        offset.push(offset.last().unwrap() + k.len());
-    }
-    let element = |v: u32, kp: u32| offset[v as usize] + kp as usize;
-    let keypoints = *offset.last().unwrap();
-    let mut tracks = UnionFind::<usize>::new(keypoints);
-    // Observations per track are its matched keypoints (one per image on a consistent track).
-    let mut matched = vec![false; keypoints];
-    for (edge, e) in graph.edges.iter().enumerate() {
-        for [a, b] in scene.edge_inliers(edge) {
-            let (x, y) = (element(e.i, a), element(e.j, b));
-            tracks.union(x, y);
-            matched[x] = true;
-            matched[y] = true;
-        }
-    }
-    let track = tracks.into_labeling();
-    let mut length = vec![0u32; matched.len()];
-    for (k, _) in matched.iter().enumerate().filter(|(_, &m)| m) {
-        length[track[k]] += 1;
-    }
-    let mut lengths: Vec<u32> = length.iter().copied().filter(|&l| l > 0).collect();
+    let tracks = Tracks::build(scene, |_| true);
+    let mut lengths: Vec<u32> = tracks.lengths().collect();
     let limit = if lengths.is_empty() {
         0
     } else {
         let mid = lengths.len() / 2;
         CONFUSING_FACTOR * *lengths.select_nth_unstable(mid).1
     };
-    let values = graph
-        .edges
-        .iter()
-        .enumerate()
-        .map(|(edge, e)| {
+    let values = (0..scene.graph.edges.len())
+        .map(|edge| {
+            let i = scene.graph.edges[edge].i;
             let (mut unique, mut all) = (0usize, 0usize);
             for [a, _] in scene.edge_inliers(edge) {
                 all += 1;
-                unique += (length[track[element(e.i, a)]] <= limit) as usize;
+                unique += (tracks.length(i, a) <= limit) as usize;
             }
             if all == 0 {
                 0.0
