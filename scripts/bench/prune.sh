@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Whole-prune benchmark at scale: generates a synthetic matched COLMAP database of 1,000 images
 # (~100K verified pairs, hundreds of inliers each, exhaustive-matcher rows for all 500K pairs),
-# then runs `prune --preset general` on it in place under /usr/bin/time -v, on at most 2 cores,
+# then runs `prune --preset $PRESET` (default general) on it in place under /usr/bin/time -v, on at most 2 cores,
 # and prints wall time, peak memory and the report's timings (read, priors, solve, write).
 # usage: scripts/bench/prune.sh [--num_images 1000] [--num_points 24000] [--view_cone_degrees 16]
 # The database is kept in $BENCH_DIR (default target/bench) and reused when its spec is unchanged.
@@ -32,7 +32,7 @@ db="$work/prune_run.db"
 cp "$original" "$db"
 "$bin" inspect --database_path "$db" >&2
 export RAYON_NUM_THREADS=2
-/usr/bin/time -v "$bin" prune --database_path "$db" --preset general --report "$work/prune_report.json" \
+/usr/bin/time -v "$bin" prune --database_path "$db" --preset "${PRESET:-general}" --report "$work/prune_report.json" \
   2> "$work/prune_time.txt"
 grep -E "Elapsed|Maximum resident|Percent of CPU" "$work/prune_time.txt"
 python3 - "$work/prune_report.json" <<'PY'

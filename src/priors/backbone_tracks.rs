@@ -21,6 +21,7 @@ use super::PriorValues;
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::Scene;
 use petgraph::unionfind::UnionFind;
+use rayon::prelude::*;
 
 /// A pair among this many strongest pairs of both its images is in the backbone.
 pub const NEIGHBOURS: usize = 3;
@@ -30,12 +31,10 @@ pub const NEIGHBOURS: usize = 3;
 pub fn compute(scene: &Scene) -> PriorValues {
     let backbone = backbone(scene.graph, &strengths(scene));
     let tracks = Tracks::build(scene, |edge| backbone[edge]);
-    let values = scene
-        .graph
-        .edges
-        .iter()
-        .enumerate()
-        .map(|(edge, e)| {
+    let values = (0..scene.graph.edges.len())
+        .into_par_iter()
+        .map(|edge| {
+            let e = &scene.graph.edges[edge];
             if backbone[edge] {
                 return 1.0;
             }
@@ -62,6 +61,7 @@ pub fn compute(scene: &Scene) -> PriorValues {
 fn strengths(scene: &Scene) -> Vec<f64> {
     let all = Tracks::build(scene, |_| true);
     (0..scene.graph.edges.len())
+        .into_par_iter()
         .map(|edge| {
             let i = scene.graph.edges[edge].i;
             scene

@@ -6,11 +6,15 @@
 //! Three variants: `context` (cosine of w_ij and w_ji, the paper's), `context_hamming` (number of
 //! images on which the binarised vectors differ, the paper's alternative; lower is better) and
 //! `context_outside` (cosine, with U_i restricted to features outside the convex hull of the
-//! pair's inliers, and each image k weighted by ln(N / (1 + degree of k)): the features on the
+//! pair's inliers, and each image k weighted by ln(1 + N / (1 + degree of k)): the features on the
 //! duplicated object that this pair did not match still match both copies' images, which blurs
 //! the literal context, and images that match nearly everything (overviews) dominate a raw
 //! cosine while saying nothing about which instance a view sees; outside the matched region, with
-//! such images down-weighted as in TF-IDF, the distinct surroundings remain).
+//! such images down-weighted as in TF-IDF, the distinct surroundings remain). The weight is the
+//! smoothed IDF: with the plain ln(N / (1 + degree)) every weight is 0 when every image matches
+//! every other, as in small exhaustively matched sets, and the variant was constant there.
+//! `context_hamming` is constant on such complete view graphs by its definition (every context
+//! vector names every other image).
 
 use super::overlap::convex_hull;
 use super::PriorValues;
@@ -85,11 +89,7 @@ fn inside(hull: &[[f32; 2]], p: [f32; 2]) -> bool {
 pub fn compute(scene: &Scene) -> Vec<PriorValues> {
     let features = matched_features(scene);
     let n = scene.graph.num_vertices() as f64;
-    let idf = |k: u32| {
-        (n / (1.0 + scene.graph.degree(k as usize) as f64))
-            .ln()
-            .max(0.0)
-    };
+    let idf = |k: u32| (1.0 + n / (1.0 + scene.graph.degree(k as usize) as f64)).ln();
     let rows: Vec<[f64; 3]> = (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
@@ -180,6 +180,33 @@ mod tests {
         // The literal variant sees the shared object features (matched to 2 and 4 by both).
         assert!(at("context", 1, 4) > 0.0);
         assert!(at("context_hamming", 1, 4) > at("context_hamming", 1, 2));
+    }
+
+    #[test]
+    fn outside_context_is_seen_when_every_image_matches_every_other() {
+        // Images 1..=4, every pair matched: (1, 2) on the object's outer ring (keypoints
+        // 0..10, whose hull holds the inner ring 10..20), images 1 and 2 share their
+        // surroundings (20..40) with image 3, and image 4 matches the others on the inner ring.
+        let (_, _, keypoints) = two_copies();
+        let pair = |a, b, range: std::ops::Range<u32>| pair(a, b, range.map(|k| [k, k]).collect());
+        let pairs = vec![
+            pair(1, 2, 0..10),
+            pair(1, 3, 20..40),
+            pair(2, 3, 20..40),
+            pair(1, 4, 10..20),
+            pair(2, 4, 10..20),
+            pair(3, 4, 10..20),
+        ];
+        let graph = ViewGraph::build(&images(4), &pairs, 1);
+        let scene = Scene::new(&graph, &pairs, keypoints[..4].to_vec(), vec![(640, 480); 4]);
+        let values = compute(&scene);
+        let outside = &values.iter().find(|p| p.name == "context_outside").unwrap();
+        let edge = graph
+            .edges
+            .iter()
+            .position(|e| (e.i, e.j) == (0, 1))
+            .unwrap();
+        assert!(outside.values[edge] > 0.99, "{}", outside.values[edge]);
     }
 
     #[test]

@@ -7,6 +7,7 @@ use crate::colmap::rewrite;
 use crate::costs::{self, CostModel, Costs};
 use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
 use crate::flow::search::{self, FlowRule, SearchResult};
+use crate::geometry::camera::CameraModel;
 use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, PriorValues};
 use crate::scene::view_graph::ViewGraph;
@@ -272,6 +273,10 @@ fn load_scene<'a>(
             Ok((w, h))
         })
         .collect::<Result<Vec<_>>>()?;
+    // A camera the mapper could not use is refused whether or not the priors read it.
+    for c in cameras.iter().filter(|c| camera_ids.contains(&c.camera_id)) {
+        CameraModel::from_colmap(c)?;
+    }
     stage("reading keypoints");
     let keypoints = graph
         .image_ids
@@ -408,9 +413,14 @@ mod tests {
             curve_factor: 0,
             capture: Default::default(),
         };
-        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach 0.6 already, and
-        // half of 0.4 pairs per image x 5 images is one pair.
-        assert_eq!(fitness_floor(&options(0.6, 0.4, None), &graph, &costs), 0.6);
+        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor
+        // (0.6) already, and half of 0.4 pairs per image x 5 images is one pair.
+        let preset = CostModel::disambiguation().min_pair_fitness;
+        assert!(preset <= 0.8);
+        assert_eq!(
+            fitness_floor(&options(0.6, 0.4, None), &graph, &costs),
+            preset
+        );
         // Four images need the floor at 0.2, all five at 0.1.
         assert_eq!(fitness_floor(&options(0.8, 0.4, None), &graph, &costs), 0.2);
         assert_eq!(fitness_floor(&options(1.0, 0.4, None), &graph, &costs), 0.1);
@@ -419,7 +429,7 @@ mod tests {
         // A fixed flow takes the floor as given.
         assert_eq!(
             fitness_floor(&options(1.0, 1.2, Some(3)), &graph, &costs),
-            0.6
+            preset
         );
     }
 }

@@ -12,10 +12,11 @@ pub enum Preset {
     /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
     /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
     General,
-    /// For scenes with duplicate or symmetric structure: pair priors loop consistency (rotations
-    /// and translations of every triangle) and unique tracks, pairs below fitness 0.6 never
-    /// selected; the paper's context and multiple motions at weight 0 (in --scores). Search: 80%
-    /// of images, 5 pairs per image.
+    /// For scenes with duplicate or symmetric structure, whatever the image order: pair prior
+    /// backbone tracks (the share of a pair's inliers that tracks through each image's strongest
+    /// pairs join), pairs below fitness 0.6 never selected (lowered as far as the search needs);
+    /// the paper's context, loop and multiple motions, loop fraction and unique tracks at weight
+    /// 0 (in --scores). Search: 80% of images, 5 pairs per image.
     Disambiguation,
     /// The paper's section 5.1 as written, for its lab scenes: context similarity, loop
     /// consistency and multiple motions with uniform weights, no fitness floor; search: 25% of
