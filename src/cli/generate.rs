@@ -46,6 +46,10 @@ enum SceneArg {
     Room,
     /// Two identical objects in differently textured halves of a room, linked by a walk.
     Duplicate,
+    /// Two identical objects far apart, each orbited all round, linked by a few overview views.
+    Twin,
+    /// One object that looks the same from opposite sides, orbited all round.
+    Symmetric,
 }
 
 #[derive(Args)]
@@ -96,6 +100,8 @@ pub fn run(command: &GenerateCommand) -> Result<()> {
             let kind = match args.scene {
                 SceneArg::Room => render::SceneKind::Room,
                 SceneArg::Duplicate => render::SceneKind::Duplicate,
+                SceneArg::Twin => render::SceneKind::Twin,
+                SceneArg::Symmetric => render::SceneKind::Symmetric,
             };
             render::Scene::build(kind, args.num_images, args.seed)
                 .and_then(|scene| scene.write(&args.output))

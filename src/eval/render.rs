@@ -37,6 +37,14 @@ pub enum SceneKind {
     /// Two identical objects in the two halves of a long room whose walls differ; each object is
     /// half-orbited the same way, and a sideways walk along the room links the two orbits.
     Duplicate,
+    /// Two identical objects far apart on a textured ground under a black sky, each orbited all
+    /// round from close by (the views share little ground beyond their own object's), linked
+    /// only by a few overview views from between them that see both.
+    Twin,
+    /// One object whose opposite faces carry the same textures and whose top sits centred, so
+    /// that views half an orbit apart look alike, alone under a black sky and on black ground,
+    /// orbited all round: the orbit's continuity is the only evidence against folding it.
+    Symmetric,
 }
 
 /// An axis-aligned box; `inside` boxes (the room) are seen from within.
@@ -49,6 +57,11 @@ struct Cuboid {
     /// Texture seeds where x >= 0 (a room whose two halves differ); `faces` elsewhere.
     east: [u64; 6],
     inside: bool,
+    /// Textures of the +x and +y faces run the other way round and the top's are folded about
+    /// its centre, so that a box whose opposite faces share their seeds looks the same after
+    /// half a turn about the vertical (without it the opposite face would be the mirror image,
+    /// which SIFT does not match).
+    half_turn: bool,
 }
 
 /// A scene and the cameras that look at it.
@@ -129,6 +142,7 @@ impl Cuboid {
             faces,
             east: faces,
             inside: false,
+            half_turn: false,
         }
     }
 
@@ -194,6 +208,41 @@ impl Scene {
                 cuboids.extend(object(0.0, 0.0));
                 cuboids.push(Cuboid::new([2.0, 3.0, 0.0], [3.5, 4.0, 1.0], tex()));
                 cuboids.push(Cuboid::new([-4.0, -3.5, 0.0], [-3.0, -2.0, 1.5], tex()));
+                orbit(&mut poses, 0.0, num_images, 0.0, TAU);
+            }
+            SceneKind::Twin => {
+                let mut ground = Cuboid::new([-16.0, -10.0, -1.0], [16.0, 10.0, 0.0], tex());
+                ground.east = tex();
+                cuboids.push(ground);
+                cuboids.extend(object(-7.0, 0.0));
+                cuboids.extend(object(7.0, 0.0));
+                let links = (num_images / 10).max(2);
+                let per_orbit = (num_images - links) / 2;
+                orbit(&mut poses, -7.0, per_orbit, 0.0, TAU);
+                orbit(&mut poses, 7.0, num_images - links - per_orbit, 0.0, TAU);
+                // Far back and high enough that both objects are in view.
+                for k in 0..links {
+                    let x = -1.5 + 3.0 * k as f64 / (links - 1) as f64;
+                    let centre = Vector3::new(x, -16.0, 6.0) + jitter(0.2);
+                    poses.push((centre, Vector3::new(x, 0.0, 0.5) + jitter(0.2)));
+                }
+            }
+            SceneKind::Symmetric => {
+                // Faces -x/+x and -y/+y share their seeds; the top box is centred.
+                let [a, _, c, _, e, f] = object_tex;
+                let [ta, _, tc, _, te, tf] = top_tex;
+                for (min, max, faces) in [
+                    ([-0.6, -0.4, 0.0], [0.6, 0.4, 0.8], [a, a, c, c, e, f]),
+                    (
+                        [-0.3, -0.25, 0.8],
+                        [0.3, 0.25, 1.3],
+                        [ta, ta, tc, tc, te, tf],
+                    ),
+                ] {
+                    let mut part = Cuboid::new(min, max, faces);
+                    part.half_turn = true;
+                    cuboids.push(part);
+                }
                 orbit(&mut poses, 0.0, num_images, 0.0, TAU);
             }
             SceneKind::Duplicate => {
@@ -279,7 +328,17 @@ impl Scene {
         let p = origin + dir * t;
         let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
         let faces = if p.x >= 0.0 { &c.east } else { &c.faces };
-        let grey = texture(faces[2 * axis + side], p[a] - c.min[a], p[b] - c.min[b]);
+        // Face coordinates; on a half-turn box the +x and +y faces count their horizontal one
+        // from the far end, and the tops fold both about the centre (symmetric under the turn).
+        let along = |k: usize| {
+            let (from_min, from_max) = (p[k] - c.min[k], c.max[k] - p[k]);
+            match (c.half_turn, axis) {
+                (true, 2) => from_min.min(from_max),
+                (true, _) if side == 1 && k < 2 => from_max,
+                _ => from_min,
+            }
+        };
+        let grey = texture(faces[2 * axis + side], along(a), along(b));
         let light = [0.75, 0.9, 0.6][axis] * if side == 0 { 0.85 } else { 1.0 };
         grey * light
     }
@@ -375,6 +434,52 @@ mod tests {
         assert_eq!(b.min - a.min, Vector3::new(10.0, 0.0, 0.0));
         let room = &scene.cuboids[0];
         assert_ne!(room.faces, room.east, "the halves of the room must differ");
+    }
+
+    /// The symmetric object looks the same after half a turn: each side face point and its
+    /// turned twin have the same texture (the light differs by side, 0.85 against 1), and so do
+    /// points of the top.
+    #[test]
+    fn symmetric_object_is_the_same_after_half_a_turn() {
+        let scene = Scene::build(SceneKind::Symmetric, 8, 2).unwrap();
+        let grey = |p: Vector3<f64>, outward: Vector3<f64>| scene.shade(&(p + outward), &-outward);
+        let turn = |p: Vector3<f64>| Vector3::new(-p.x, -p.y, p.z);
+        for (y, z) in [(-0.31, 0.1), (0.05, 0.42), (0.27, 0.77)] {
+            let p = Vector3::new(-0.6, y, z);
+            let (a, b) = (grey(p, -Vector3::x()), grey(turn(p), Vector3::x()));
+            assert!((a / 0.85 - b).abs() < 1e-9, "x faces at {y} {z}: {a} {b}");
+            let q = Vector3::new(y, -0.4, z);
+            let (a, b) = (grey(q, -Vector3::y()), grey(turn(q), Vector3::y()));
+            assert!((a / 0.85 - b).abs() < 1e-9, "y faces at {y} {z}: {a} {b}");
+        }
+        for (x, y) in [(-0.21, 0.13), (0.08, -0.2)] {
+            let p = Vector3::new(x, y, 1.3);
+            assert_eq!(grey(p, Vector3::z()), grey(turn(p), Vector3::z()));
+        }
+        // Not trivially: the faces are textured.
+        let p = Vector3::new(-0.6, 0.0, 0.4);
+        let samples: Vec<f64> = (0..20)
+            .map(|k| grey(p + Vector3::y() * (k as f64 * 0.03), -Vector3::x()))
+            .collect();
+        assert!(samples.iter().any(|&g| (g - samples[0]).abs() > 0.1));
+    }
+
+    /// The twin scene's objects are identical and far apart, and its link views see both.
+    #[test]
+    fn twin_objects_are_identical_and_the_links_see_both() {
+        let scene = Scene::build(SceneKind::Twin, 36, 1).unwrap();
+        let (a, b) = (&scene.cuboids[1], &scene.cuboids[3]);
+        assert_eq!(a.faces, b.faces);
+        assert_eq!(b.min - a.min, Vector3::new(14.0, 0.0, 0.0));
+        let links = &scene.truth.images[32..];
+        assert_eq!(links.len(), 4);
+        for im in links {
+            for x in [-7.0, 7.0] {
+                let c = im.rotation * Vector3::new(x, 0.0, 0.7) + im.translation;
+                let (u, v) = (FOCAL * c.x / c.z + 240.0, FOCAL * c.y / c.z + 180.0);
+                assert!(c.z > 0.0 && (0.0..480.0).contains(&u) && (0.0..360.0).contains(&v));
+            }
+        }
     }
 
     #[test]

@@ -38,16 +38,7 @@ pub fn compute(scene: &Scene) -> PriorValues {
             if backbone[edge] {
                 return 1.0;
             }
-            let (mut joined, mut count) = (0usize, 0usize);
-            for [a, b] in scene.edge_inliers(edge) {
-                count += 1;
-                joined += (tracks.track(e.i, a) == tracks.track(e.j, b)) as usize;
-            }
-            if count == 0 {
-                0.0
-            } else {
-                joined as f64 / count as f64
-            }
+            tracks.inlier_share(scene, edge, |t, [a, b]| t.track(e.i, a) == t.track(e.j, b))
         })
         .collect();
     PriorValues {

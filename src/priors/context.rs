@@ -133,17 +133,23 @@ mod tests {
     /// surroundings seen by image 5. Pair (1, 2) is true, pair (1, 4) false: the copies match
     /// on keypoints 0..20 (pair (1, 4) only on 0..10, whose hull holds 10..20), the
     /// surroundings are keypoints 20..40.
+    /// Pairs (a, b) matching keypoint k of a to keypoint k of b for k in the range.
+    fn ranges(spec: &[(u32, u32, std::ops::Range<u32>)]) -> Vec<VerifiedPair> {
+        spec.iter()
+            .map(|(a, b, r)| pair(*a, *b, r.clone().map(|k| [k, k]).collect()))
+            .collect()
+    }
+
     fn two_copies() -> (Vec<Image>, Vec<VerifiedPair>, Vec<Vec<[f32; 2]>>) {
         let images = images(5);
-        let pair = |a, b, range: std::ops::Range<u32>| pair(a, b, range.map(|k| [k, k]).collect());
-        let pairs = vec![
-            pair(1, 2, 0..20),
-            pair(1, 3, 20..40),
-            pair(2, 3, 20..40),
-            pair(1, 4, 0..10),
-            pair(2, 4, 0..20),
-            pair(4, 5, 20..40),
-        ];
+        let pairs = ranges(&[
+            (1, 2, 0..20),
+            (1, 3, 20..40),
+            (2, 3, 20..40),
+            (1, 4, 0..10),
+            (2, 4, 0..20),
+            (4, 5, 20..40),
+        ]);
         // Object in the image centre (keypoints 0..20), surroundings on the border.
         let kp = (0..40)
             .map(|k| {
@@ -188,15 +194,14 @@ mod tests {
         // 0..10, whose hull holds the inner ring 10..20), images 1 and 2 share their
         // surroundings (20..40) with image 3, and image 4 matches the others on the inner ring.
         let (_, _, keypoints) = two_copies();
-        let pair = |a, b, range: std::ops::Range<u32>| pair(a, b, range.map(|k| [k, k]).collect());
-        let pairs = vec![
-            pair(1, 2, 0..10),
-            pair(1, 3, 20..40),
-            pair(2, 3, 20..40),
-            pair(1, 4, 10..20),
-            pair(2, 4, 10..20),
-            pair(3, 4, 10..20),
-        ];
+        let pairs = ranges(&[
+            (1, 2, 0..10),
+            (1, 3, 20..40),
+            (2, 3, 20..40),
+            (1, 4, 10..20),
+            (2, 4, 10..20),
+            (3, 4, 10..20),
+        ]);
         let graph = ViewGraph::build(&images(4), &pairs, 1);
         let scene = Scene::new(&graph, &pairs, keypoints[..4].to_vec(), vec![(640, 480); 4]);
         let values = compute(&scene);

@@ -61,6 +61,26 @@ impl Tracks {
         self.length[self.track(v, kp)]
     }
 
+    /// Share in [0, 1] of `edge`'s inliers (oriented from its vertex `i` to `j`) for which
+    /// `holds(self, inlier)` is true; 0 without inliers.
+    pub fn inlier_share(
+        &self,
+        scene: &Scene,
+        edge: usize,
+        holds: impl Fn(&Tracks, [u32; 2]) -> bool,
+    ) -> f64 {
+        let (mut yes, mut all) = (0usize, 0usize);
+        for inlier in scene.edge_inliers(edge) {
+            all += 1;
+            yes += holds(self, inlier) as usize;
+        }
+        if all == 0 {
+            0.0
+        } else {
+            yes as f64 / all as f64
+        }
+    }
+
     /// Observations of every track that has any.
     pub fn lengths(&self) -> impl Iterator<Item = u32> + '_ {
         self.length.iter().copied().filter(|&l| l > 0)

@@ -30,16 +30,7 @@ pub fn compute(scene: &Scene) -> PriorValues {
     let values = (0..scene.graph.edges.len())
         .map(|edge| {
             let i = scene.graph.edges[edge].i;
-            let (mut unique, mut all) = (0usize, 0usize);
-            for [a, _] in scene.edge_inliers(edge) {
-                all += 1;
-                unique += (tracks.length(i, a) <= limit) as usize;
-            }
-            if all == 0 {
-                0.0
-            } else {
-                unique as f64 / all as f64
-            }
+            tracks.inlier_share(scene, edge, |t, [a, _]| t.length(i, a) <= limit)
         })
         .collect();
     PriorValues {
