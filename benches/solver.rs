@@ -15,6 +15,7 @@ fn bench_solver(c: &mut Criterion) {
             min_image_fraction: 0.9,
             min_pairs_per_image: 5.0,
             min_pair_fraction: 0.0,
+            min_pairs_each: 0.0,
         });
         group.bench_function(format!("search {images}/{pairs}"), |b| {
             b.iter(|| search(&problem, &rule))

@@ -22,6 +22,7 @@ fn criteria(a: f64, b: f64) -> FlowRule {
         min_image_fraction: a,
         min_pairs_per_image: b,
         min_pair_fraction: 0.0,
+        min_pairs_each: 0.0,
     })
 }
 
@@ -184,6 +185,7 @@ fn the_pair_fraction_raises_the_pair_target_and_the_flow() {
         min_image_fraction: 0.0,
         min_pairs_per_image: per_image,
         min_pair_fraction: fraction,
+        min_pairs_each: 0.0,
     };
     // 25% of 700 pairs = 175 > 1 x 80 images; the larger target wins either way round.
     assert_eq!(targets(&p, &with(1.0, 0.25)), (0, 175));
@@ -194,6 +196,59 @@ fn the_pair_fraction_raises_the_pair_target_and_the_flow() {
     assert!(pairs >= 175 && status(&r, "pairs").binding);
     let (_, before) = counts(&solve(&p, r.selection.flow - 1));
     assert!(before < 175);
+}
+
+/// Selected pairs of each image, counted independently of the search.
+fn selected_degrees(p: &SelectionProblem, s: &Selection) -> Vec<usize> {
+    let mut d = vec![0; p.image_costs.len()];
+    for (arc, &on) in p.pairs.iter().zip(&s.pairs) {
+        if on {
+            d[arc.i as usize] += 1;
+            d[arc.j as usize] += 1;
+        }
+    }
+    d
+}
+
+#[test]
+fn every_image_keeps_its_own_pairs_at_the_smallest_such_flow() {
+    for (seed, k) in [(6u64, 1.0f64), (7, 2.0), (8, 3.0), (9, 2.5)] {
+        let p = random_problem(60, 400, seed);
+        let full = selected_degrees(
+            &p,
+            &Selection {
+                pairs: vec![true; p.pairs.len()],
+                ..solve(&p, 0)
+            },
+        );
+        let need: Vec<usize> = full.iter().map(|&d| d.min(k.ceil() as usize)).collect();
+        let holds = |s: &Selection| {
+            selected_degrees(&p, s)
+                .iter()
+                .zip(&need)
+                .all(|(&got, &n)| got >= n)
+        };
+        let rule = FlowRule::Criteria(Criteria {
+            min_image_fraction: 0.0,
+            min_pairs_per_image: 0.0,
+            min_pair_fraction: 0.0,
+            min_pairs_each: k,
+        });
+        let r = search(&p, &rule);
+        assert!(!r.capped, "seed {seed}");
+        let f = r.selection.flow;
+        assert_eq!(r.selection, solve(&p, f));
+        assert!(holds(&r.selection), "seed {seed}: not met at F = {f}");
+        for smaller in 0..f {
+            assert!(
+                !holds(&solve(&p, smaller)),
+                "seed {seed}: met at F = {smaller} < {f}"
+            );
+        }
+        let each = status(&r, "pairs_each");
+        assert!(each.met && each.binding);
+        assert_eq!(each.target, need.iter().filter(|&&n| n > 0).count() as f64);
+    }
 }
 
 #[test]

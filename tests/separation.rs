@@ -35,6 +35,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
             min_image_fraction: 0.8,
             min_pairs_per_image: 5.0,
             min_pair_fraction: 0.0,
+            min_pairs_each: 0.0,
         }),
         model: all_priors(),
         unweighted_priors: true,

@@ -411,6 +411,7 @@ fn timing_paper_graph_1k_100k() {
         min_image_fraction: 0.9,
         min_pairs_per_image: 5.0,
         min_pair_fraction: 0.0,
+        min_pairs_each: 0.0,
     };
     let r = search(&p, &FlowRule::Criteria(crit));
     println!(

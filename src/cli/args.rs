@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use std::time::Duration;
 use vgsel_colmap::colmap::database::Database;
-use vgsel_colmap::flow::search::FlowRule;
+use vgsel_colmap::flow::search::{Criteria, FlowRule, GivenCriteria};
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -31,7 +31,7 @@ impl DatabaseArg {
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
@@ -45,38 +45,45 @@ pub struct FlowArgs {
     /// [default: 0, paper-disambiguation preset 0.25].
     #[arg(long, value_parser = fraction)]
     min_pair_fraction: Option<f64>,
+    /// Search: ... and every image keeps at least this many of its pairs (all it has, if
+    /// fewer) [default: 0 (off)].
+    #[arg(long, value_parser = non_negative)]
+    min_pairs_each: Option<f64>,
 }
 
 impl FlowArgs {
-    /// The flow rule, with `defaults` (image fraction, pairs per image, pair fraction) for unset
-    /// criteria.
-    pub fn rule(&self, defaults: (f64, f64, f64)) -> FlowRule {
-        FlowRule::new(
-            self.flow,
-            self.min_image_fraction,
-            self.min_pairs_per_image,
-            self.min_pair_fraction,
-            defaults,
-        )
+    /// The flow rule, with `defaults` for unset criteria.
+    pub fn rule(&self, defaults: Criteria) -> FlowRule {
+        FlowRule::new(self.flow, self.given(), defaults)
     }
 
-    /// The parameters' view of these options: (fixed flow, image fraction, pairs per image, pair
-    /// fraction), the criteria filled from `defaults` unless the flow is fixed.
-    pub fn parts(&self, defaults: (f64, f64, f64)) -> FlowParts {
+    /// The criteria as given on the command line.
+    fn given(&self) -> GivenCriteria {
+        GivenCriteria {
+            min_image_fraction: self.min_image_fraction,
+            min_pairs_per_image: self.min_pairs_per_image,
+            min_pair_fraction: self.min_pair_fraction,
+            min_pairs_each: self.min_pairs_each,
+        }
+    }
+
+    /// The parameters' view of these options: the fixed flow, or the criteria filled from
+    /// `defaults`.
+    pub fn parts(&self, defaults: Criteria) -> (Option<u64>, GivenCriteria) {
         match self.rule(defaults) {
-            FlowRule::Fixed(f) => (Some(f), None, None, None),
+            FlowRule::Fixed(f) => (Some(f), GivenCriteria::default()),
             FlowRule::Criteria(c) => (
                 None,
-                Some(c.min_image_fraction),
-                Some(c.min_pairs_per_image),
-                Some(c.min_pair_fraction),
+                GivenCriteria {
+                    min_image_fraction: Some(c.min_image_fraction),
+                    min_pairs_per_image: Some(c.min_pairs_per_image),
+                    min_pair_fraction: Some(c.min_pair_fraction),
+                    min_pairs_each: Some(c.min_pairs_each),
+                },
             ),
         }
     }
 }
-
-/// (fixed flow, image fraction, pairs per image, pair fraction) as the parameters record them.
-pub type FlowParts = (Option<u64>, Option<f64>, Option<f64>, Option<f64>);
 
 #[derive(Clone, Debug)]
 pub struct Weights(pub Vec<(String, f64)>);

@@ -131,16 +131,16 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         model.min_pair_fitness = floor;
     }
     let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
-    let (flow, min_image_fraction, min_pairs_per_image, min_pair_fraction) =
-        args.flow.parts(args.preset.criteria());
+    let (flow, given) = args.flow.parts(args.preset.criteria());
     let parameters = Parameters {
         preset: args.preset,
         cost_model: model,
         min_num_matches: args.min_num_matches,
         flow,
-        min_image_fraction,
-        min_pairs_per_image,
-        min_pair_fraction,
+        min_image_fraction: given.min_image_fraction,
+        min_pairs_per_image: given.min_pairs_per_image,
+        min_pair_fraction: given.min_pair_fraction,
+        min_pairs_each: given.min_pairs_each,
         order: args.order,
         image_path: path_text(&args.image_path),
         keep_pairs: path_text(&args.keep_pairs),

@@ -35,24 +35,38 @@ pub enum FlowRule {
 }
 
 impl FlowRule {
-    /// A fixed flow when `flow` is set, else the criteria, each taken from `defaults` (image
-    /// fraction, pairs per image, pair fraction) where unset.
-    pub fn new(
-        flow: Option<u64>,
-        min_image_fraction: Option<f64>,
-        min_pairs_per_image: Option<f64>,
-        min_pair_fraction: Option<f64>,
-        defaults: (f64, f64, f64),
-    ) -> FlowRule {
+    /// A fixed flow when `flow` is set, else the criteria `given`, each taken from `defaults`
+    /// where unset.
+    pub fn new(flow: Option<u64>, given: GivenCriteria, defaults: Criteria) -> FlowRule {
         match flow {
             Some(f) => FlowRule::Fixed(f),
             None => FlowRule::Criteria(Criteria {
-                min_image_fraction: min_image_fraction.unwrap_or(defaults.0),
-                min_pairs_per_image: min_pairs_per_image.unwrap_or(defaults.1),
-                min_pair_fraction: min_pair_fraction.unwrap_or(defaults.2),
+                min_image_fraction: given
+                    .min_image_fraction
+                    .unwrap_or(defaults.min_image_fraction),
+                min_pairs_per_image: given
+                    .min_pairs_per_image
+                    .unwrap_or(defaults.min_pairs_per_image),
+                min_pair_fraction: given
+                    .min_pair_fraction
+                    .unwrap_or(defaults.min_pair_fraction),
+                min_pairs_each: given.min_pairs_each.unwrap_or(defaults.min_pairs_each),
             }),
         }
     }
+}
+
+/// Criteria as a user may give them: any of them unset.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct GivenCriteria {
+    /// See [`Criteria::min_image_fraction`].
+    pub min_image_fraction: Option<f64>,
+    /// See [`Criteria::min_pairs_per_image`].
+    pub min_pairs_per_image: Option<f64>,
+    /// See [`Criteria::min_pair_fraction`].
+    pub min_pair_fraction: Option<f64>,
+    /// See [`Criteria::min_pairs_each`].
+    pub min_pairs_each: Option<f64>,
 }
 
 /// Coverage a selection must reach: the smallest F that reaches it is chosen.
@@ -65,6 +79,10 @@ pub struct Criteria {
     /// ... and >= this share of all pairs: the paper's criterion for its dense lab scenes
     /// (about 25% of the edges); 0 for the others.
     pub min_pair_fraction: f64,
+    /// ... and every image with a pair keeps at least min(ceil(this), its degree) selected
+    /// pairs: a count per image rather than on average, so that no image is left with too few
+    /// pairs to be registered while dense parts of the graph keep many (0: off).
+    pub min_pairs_each: f64,
 }
 
 /// One criterion after the search: its target, what the chosen F reached, whether it was met.
@@ -137,6 +155,55 @@ pub fn full_selection(problem: &SelectionProblem) -> Selection {
         images: vec![true; n],
         pairs: vec![true; problem.pairs.len()],
         cost,
+    }
+}
+
+/// The per-image criterion: each image with a pair needs min(ceil(k), its degree) of its pairs
+/// selected.
+struct EachImage {
+    /// The images of each pair, as in the problem.
+    ends: Vec<(u32, u32)>,
+    /// Pairs each image needs (0 for images without pairs, or when the criterion is off).
+    need: Vec<u32>,
+    /// Images that need any.
+    target: usize,
+}
+
+impl EachImage {
+    fn new(problem: &SelectionProblem, k: f64) -> EachImage {
+        let mut degree = vec![0u32; problem.image_costs.len()];
+        for p in &problem.pairs {
+            degree[p.i as usize] += 1;
+            degree[p.j as usize] += 1;
+        }
+        let k = k.ceil().max(0.0) as u32;
+        let need: Vec<u32> = degree.iter().map(|&d| d.min(k)).collect();
+        let target = need.iter().filter(|&&n| n > 0).count();
+        let ends = problem.pairs.iter().map(|p| (p.i, p.j)).collect();
+        EachImage { ends, need, target }
+    }
+
+    fn active(&self) -> bool {
+        self.target > 0
+    }
+
+    /// Images whose need the solver's current selection meets (images without need excluded).
+    fn met(&self, solver: &ParametricSolver) -> usize {
+        if !self.active() {
+            return 0;
+        }
+        let mut selected = vec![0u32; self.need.len()];
+        for (k, &(i, j)) in self.ends.iter().enumerate() {
+            if solver.pair_selected(k) {
+                selected[i as usize] += 1;
+                selected[j as usize] += 1;
+            }
+        }
+        self.need
+            .iter()
+            .zip(&selected)
+            .filter(|(&n, &s)| n > 0 && s >= n)
+            .count()
     }
 }
 
@@ -234,10 +301,18 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
         }
         FlowRule::Criteria(criteria) => {
             let (target_images, target_pairs) = targets(problem, &criteria);
-            let meets = |p: &CurvePoint| {
-                (
+            let each = EachImage::new(problem, criteria.min_pairs_each);
+            // (images, pairs, each image's own pairs); the last is counted only once the first
+            // two hold, as it reads the whole selection.
+            let meets = |solver: &ParametricSolver, p: &CurvePoint| {
+                let (images, pairs) = (
                     p.images_selected >= target_images,
                     p.pairs_selected >= target_pairs,
+                );
+                (
+                    images,
+                    pairs,
+                    images && pairs && each.met(solver) == each.target,
                 )
             };
             let reachable_images = {
@@ -252,16 +327,16 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
             let last_useful = 2 * problem.pairs.len() as u64 - target_pairs as u64;
             let mut ever = (false, false);
             let mut found = None;
-            let mut prev = (false, false);
+            let mut prev = (false, false, false);
             if target_images > reachable_images {
                 // Out of reach from the start: only the image criterion is to blame.
                 ever = (false, true);
             } else {
                 loop {
                     let p = *curve.last().unwrap();
-                    let m = meets(&p);
+                    let m = meets(solver, &p);
                     ever = (ever.0 || m.0, ever.1 || m.1);
-                    if m.0 && m.1 {
+                    if m.0 && m.1 && m.2 {
                         found = Some(p);
                         break;
                     }
@@ -284,7 +359,7 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
                 Some(p) => {
                     // Binding: not met at F - 1 (none at F = 0, where nothing was needed).
                     let first = p.flow == 0;
-                    let criteria = vec![
+                    let mut criteria = vec![
                         status(
                             "images",
                             target_images,
@@ -293,6 +368,11 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
                         ),
                         status("pairs", target_pairs, p.pairs_selected, !first && !prev.1),
                     ];
+                    if each.active() {
+                        // Binding when the others held at F - 1 and it did not.
+                        let binding = !first && prev.0 && prev.1 && !prev.2;
+                        criteria.push(status("pairs_each", each.target, each.met(solver), binding));
+                    }
                     SearchResult {
                         selection: solver.selection(),
                         criteria,
@@ -306,7 +386,7 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
                     // at some F but never together.
                     let both = ever.0 && ever.1;
                     let selection = full_selection(problem);
-                    let criteria = vec![
+                    let mut criteria = vec![
                         status(
                             "images",
                             target_images,
@@ -315,6 +395,9 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
                         ),
                         status("pairs", target_pairs, problem.pairs.len(), both || !ever.1),
                     ];
+                    if each.active() {
+                        criteria.push(status("pairs_each", each.target, each.target, false));
+                    }
                     SearchResult {
                         selection,
                         criteria,

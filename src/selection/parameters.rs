@@ -3,7 +3,7 @@
 //! `export` reads it back to recompute the very costs that drove the selection.
 
 use crate::costs::CostModel;
-use crate::flow::search::FlowRule;
+use crate::flow::search::{FlowRule, GivenCriteria};
 use crate::selection::capture_order::{self, Order};
 use crate::selection::pipeline::Options;
 use crate::selection::preset::Preset;
@@ -27,6 +27,9 @@ pub struct Parameters {
     /// The search's share-of-pairs criterion (None with a fixed flow or in older records).
     #[serde(default)]
     pub min_pair_fraction: Option<f64>,
+    /// The search's per-image criterion (None with a fixed flow or in older records).
+    #[serde(default)]
+    pub min_pairs_each: Option<f64>,
     /// The order the network's pair arcs follow (image_id in older records).
     #[serde(default)]
     pub order: Order,
@@ -44,15 +47,16 @@ pub struct Parameters {
 impl Parameters {
     /// A preset's parameters: its cost model and search criteria, no overrides.
     pub fn of_preset(preset: Preset, min_num_matches: usize) -> Parameters {
-        let (fraction, per_image, pair_fraction) = preset.criteria();
+        let c = preset.criteria();
         Parameters {
             preset,
             cost_model: preset.model(),
             min_num_matches,
             flow: None,
-            min_image_fraction: Some(fraction),
-            min_pairs_per_image: Some(per_image),
-            min_pair_fraction: Some(pair_fraction),
+            min_image_fraction: Some(c.min_image_fraction),
+            min_pairs_per_image: Some(c.min_pairs_per_image),
+            min_pair_fraction: Some(c.min_pair_fraction),
+            min_pairs_each: Some(c.min_pairs_each),
             order: Order::default(),
             image_path: None,
             keep_pairs: None,
@@ -63,13 +67,13 @@ impl Parameters {
 
     /// The flow rule: the fixed F, or the search criteria (the preset's where unset).
     pub fn rule(&self) -> FlowRule {
-        FlowRule::new(
-            self.flow,
-            self.min_image_fraction,
-            self.min_pairs_per_image,
-            self.min_pair_fraction,
-            self.preset.criteria(),
-        )
+        let given = GivenCriteria {
+            min_image_fraction: self.min_image_fraction,
+            min_pairs_per_image: self.min_pairs_per_image,
+            min_pair_fraction: self.min_pair_fraction,
+            min_pairs_each: self.min_pairs_each,
+        };
+        FlowRule::new(self.flow, given, self.preset.criteria())
     }
 
     /// The pipeline's options; `unweighted_priors` also computes the priors of weight 0.

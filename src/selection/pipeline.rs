@@ -406,6 +406,7 @@ mod tests {
                     min_image_fraction: fraction,
                     min_pairs_per_image: per_image,
                     min_pair_fraction: 0.0,
+                    min_pairs_each: 0.0,
                 }),
             },
             model: CostModel::disambiguation(),

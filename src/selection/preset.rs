@@ -2,6 +2,7 @@
 //! the flow-search criteria that go with it, in one place.
 
 use crate::costs::CostModel;
+use crate::flow::search::Criteria;
 use clap::ValueEnum;
 use serde::{Deserialize, Serialize};
 
@@ -45,12 +46,19 @@ impl Preset {
         }
     }
 
-    /// The paper's flow-search criteria: (image fraction, pairs per image, pair fraction).
-    pub fn criteria(self) -> (f64, f64, f64) {
-        match self {
-            Preset::General => (0.9, 20.0, 0.0),
-            Preset::Disambiguation => (0.8, 5.0, 0.0),
-            Preset::PaperDisambiguation => (0.0, 0.0, 0.25),
+    /// The flow-search criteria.
+    pub fn criteria(self) -> Criteria {
+        let (min_image_fraction, min_pairs_per_image, min_pair_fraction, min_pairs_each) =
+            match self {
+                Preset::General => (0.9, 20.0, 0.0, 0.0),
+                Preset::Disambiguation => (0.8, 5.0, 0.0, 0.0),
+                Preset::PaperDisambiguation => (0.0, 0.0, 0.25, 0.0),
+            };
+        Criteria {
+            min_image_fraction,
+            min_pairs_per_image,
+            min_pair_fraction,
+            min_pairs_each,
         }
     }
 }
