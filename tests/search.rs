@@ -2,7 +2,7 @@
 
 use vgsel_colmap::flow::network::{Selection, SelectionProblem};
 use vgsel_colmap::flow::search::{
-    search, search_with_curve, targets, Criteria, FlowRule, SearchResult,
+    search, search_with_curve, targets, Criteria, FlowRule, SearchResult, SelectionCheck,
 };
 use vgsel_colmap::flow::solver::{solve, ParametricSolver};
 
@@ -251,13 +251,67 @@ fn every_image_keeps_its_own_pairs_at_the_smallest_such_flow() {
     }
 }
 
+/// A caller's check: the listed pairs must all be selected (one unit each).
+struct PairsSelected(Vec<usize>);
+
+impl SelectionCheck for PairsSelected {
+    fn name(&self) -> &str {
+        "listed_pairs"
+    }
+    fn target(&self) -> usize {
+        self.0.len()
+    }
+    fn achieved(&self, pairs: &[bool]) -> usize {
+        self.0.iter().filter(|&&k| pairs[k]).count()
+    }
+}
+
+#[test]
+fn a_callers_check_is_met_within_its_step_of_the_smallest_flow() {
+    for seed in 10..16u64 {
+        let p = random_problem(40, 240, seed);
+        // Three pairs the cheapest flows tend not to take: the most expensive ones.
+        let mut by_cost: Vec<usize> = (0..p.pairs.len()).collect();
+        by_cost.sort_by(|&a, &b| p.pairs[b].cost.total_cmp(&p.pairs[a].cost));
+        let check = PairsSelected(by_cost[..3].to_vec());
+        let holds = |s: &Selection| check.achieved(&s.pairs) == 3;
+        let rule = criteria(0.5, 0.0);
+        let r = search_with_curve(&p, &rule, 0, Some(&check));
+        let smallest = (0..=2 * p.pairs.len() as u64).find(|&f| {
+            let s = solve(&p, f);
+            counts(&s).0 >= 20 && holds(&s)
+        });
+        let listed = status(&r, "listed_pairs");
+        match smallest {
+            Some(f0) => {
+                assert!(!r.capped, "seed {seed}");
+                let f = r.selection.flow;
+                assert_eq!(r.selection, solve(&p, f));
+                assert!(holds(&r.selection), "seed {seed}: check not met at F = {f}");
+                // Checked at F0 or later, then every F/32 (at least 1) flows.
+                assert!(
+                    f >= f0 && f <= f0 + (f0 / 32).max(1),
+                    "seed {seed}: F {f}, smallest {f0}"
+                );
+                assert!(listed.met && listed.achieved == 3.0);
+                // Binding exactly when the image criterion held already at F - 1.
+                let images_before = f > 0 && counts(&solve(&p, f - 1)).0 >= 20;
+                assert_eq!(listed.binding, images_before, "seed {seed}");
+            }
+            None => assert!(r.capped && listed.met, "seed {seed}"),
+        }
+        // Without the check the same rule stops no later.
+        assert!(search(&p, &rule).selection.flow <= r.selection.flow);
+    }
+}
+
 #[test]
 fn curve_beyond_the_choice_continues_the_same_flows_and_keeps_the_selection() {
     for seed in 0..20 {
         let problem = random_problem(12, 30, seed);
         for rule in [criteria(0.6, 1.0), FlowRule::Fixed(3), criteria(1.0, 30.0)] {
             let plain = search(&problem, &rule);
-            let extended = search_with_curve(&problem, &rule, 4);
+            let extended = search_with_curve(&problem, &rule, 4, None);
             assert_eq!(extended.selection, plain.selection, "seed {seed}");
             assert_eq!(extended.curve.len(), plain.curve.len());
             // Every point, chosen or beyond, is what a fresh solver selects at that F.

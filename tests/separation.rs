@@ -41,6 +41,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         unweighted_priors: true,
         curve_factor: 0,
         capture: Default::default(),
+        min_track_observations: 0,
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();
     eprintln!("plan: {:?}", p.timings);

@@ -24,4 +24,5 @@ mod separation;
 mod solver;
 mod stray_files;
 mod synth;
+mod track_criterion;
 mod ux;

@@ -31,7 +31,7 @@ impl DatabaseArg {
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
@@ -49,6 +49,11 @@ pub struct FlowArgs {
     /// fewer) [default: 0 (off)].
     #[arg(long, value_parser = non_negative)]
     min_pairs_each: Option<f64>,
+    /// Search: ... and every image keeps at least this many keypoints on feature tracks of
+    /// three or more images (all it has, if fewer), so that the mapper can register it
+    /// [default: 0 (off)].
+    #[arg(long)]
+    min_track_observations: Option<usize>,
 }
 
 impl FlowArgs {
@@ -64,6 +69,14 @@ impl FlowArgs {
             min_pairs_per_image: self.min_pairs_per_image,
             min_pair_fraction: self.min_pair_fraction,
             min_pairs_each: self.min_pairs_each,
+        }
+    }
+
+    /// The track criterion: None with a fixed flow, else as given or `default`.
+    pub fn track_observations(&self, default: usize) -> Option<usize> {
+        match self.flow {
+            Some(_) => None,
+            None => Some(self.min_track_observations.unwrap_or(default)),
         }
     }
 

@@ -141,6 +141,9 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         min_pairs_per_image: given.min_pairs_per_image,
         min_pair_fraction: given.min_pair_fraction,
         min_pairs_each: given.min_pairs_each,
+        min_track_observations: args
+            .flow
+            .track_observations(args.preset.min_track_observations()),
         order: args.order,
         image_path: path_text(&args.image_path),
         keep_pairs: path_text(&args.keep_pairs),

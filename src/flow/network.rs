@@ -108,6 +108,16 @@ impl SelectionProblem {
 }
 
 impl Restriction {
+    /// The pairs of the whole problem that a selection of the restricted network's `pairs`
+    /// keeps: those selected and the fixed ones.
+    pub fn expand_pairs(&self, pairs: &[bool]) -> Vec<bool> {
+        let mut whole: Vec<bool> = self.rules.iter().map(|&r| r == ArcRule::Fixed).collect();
+        for (k, &e) in self.pair_of.iter().enumerate() {
+            whole[e] = pairs[k];
+        }
+        whole
+    }
+
     /// A selection of the restricted network as a selection of the whole problem: plus the
     /// fixed pairs and their images; removed images and arcs never selected. Flow and cost stay
     /// the restricted network's.
@@ -116,10 +126,7 @@ impl Restriction {
         for (k, &v) in self.image_of.iter().enumerate() {
             images[v as usize] = selection.images[k];
         }
-        let mut pairs: Vec<bool> = self.rules.iter().map(|&r| r == ArcRule::Fixed).collect();
-        for (k, &e) in self.pair_of.iter().enumerate() {
-            pairs[e] = selection.pairs[k];
-        }
+        let pairs = self.expand_pairs(&selection.pairs);
         for (&(i, j), rule) in self.ends.iter().zip(&self.rules) {
             if *rule == ArcRule::Fixed {
                 images[i as usize] = true;

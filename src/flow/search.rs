@@ -7,6 +7,9 @@
 //! Targets, with n = number of images in the problem: images selected >= ceil(A n) and pairs
 //! selected >= min(max(ceil(B n), ceil(P |E|)), |E|).
 //!
+//! A caller may add a [`SelectionCheck`] computed from the selected pairs (the main crate's
+//! track criterion); it is evaluated once the targets hold, in steps (see the trait).
+//!
 //! When no F meets both targets the full graph is kept (`capped`): every image and every pair
 //! selected, including images without pairs. Its `flow` is |E| and its `cost` is that of the
 //! feasible flow of value |E| saturating every pair arc and every image arc
@@ -158,6 +161,23 @@ pub fn full_selection(problem: &SelectionProblem) -> Selection {
     }
 }
 
+/// A criterion the caller computes from the selected pairs, which the network alone cannot: the
+/// main crate counts each image's observations on feature tracks with it. A criteria search
+/// evaluates it only once the other criteria hold, and as it may be costly (a union-find over
+/// every selected pair's matches) not at every F: after a failure at F the next evaluation is at
+/// F + max(1, F / 32), so the F found is at most about 3% above the smallest that meets it.
+pub trait SelectionCheck {
+    /// The criterion's name in reports.
+    fn name(&self) -> &str;
+    /// How many units (images, say) must meet it; the full graph meets all of them.
+    fn target(&self) -> usize;
+    /// How many meet it under this selection of the problem's pairs.
+    fn achieved(&self, pairs: &[bool]) -> usize;
+}
+
+/// After a failed [`SelectionCheck`] at F, the next one is at F + F / CHECK_STEP (at least F + 1).
+const CHECK_STEP: u64 = 32;
+
 /// The per-image criterion: each image with a pair needs min(ceil(k), its degree) of its pairs
 /// selected.
 struct EachImage {
@@ -218,15 +238,21 @@ fn point(solver: &ParametricSolver) -> CurvePoint {
 /// Runs `rule` on `problem`. The curve starts at F = 0 and ends at the chosen F (for a capped
 /// criteria search: at the last F examined).
 pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
-    search_with_curve(problem, rule, 0)
+    search_with_curve(problem, rule, 0, None)
 }
 
 /// [`search`], then the same solver goes on past the chosen F to record `beyond`: up to `factor`
 /// times that F (at most 2|E|), stopping once every pair is selected (`--plots` draws what more
 /// flow would buy). The selection stays the chosen one. `factor` 0 records nothing more.
-pub fn search_with_curve(problem: &SelectionProblem, rule: &FlowRule, factor: u64) -> SearchResult {
+/// A criteria search also has to meet `check` when one is given.
+pub fn search_with_curve(
+    problem: &SelectionProblem,
+    rule: &FlowRule,
+    factor: u64,
+    check: Option<&dyn SelectionCheck>,
+) -> SearchResult {
     let mut solver = ParametricSolver::new(problem);
-    let mut result = run(&mut solver, problem, rule);
+    let mut result = run(&mut solver, problem, rule, check);
     if factor > 0 {
         let end = CurveEnd::new(problem, &result, factor);
         while !end.complete(&point(&solver))
@@ -284,7 +310,12 @@ impl SearchResult {
     }
 }
 
-fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
+fn run(
+    solver: &mut ParametricSolver,
+    problem: &SelectionProblem,
+    rule: &FlowRule,
+    check: Option<&dyn SelectionCheck>,
+) -> SearchResult {
     let mut curve = vec![point(solver)];
     match *rule {
         FlowRule::Fixed(f) => {
@@ -302,19 +333,6 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
         FlowRule::Criteria(criteria) => {
             let (target_images, target_pairs) = targets(problem, &criteria);
             let each = EachImage::new(problem, criteria.min_pairs_each);
-            // (images, pairs, each image's own pairs); the last is counted only once the first
-            // two hold, as it reads the whole selection.
-            let meets = |solver: &ParametricSolver, p: &CurvePoint| {
-                let (images, pairs) = (
-                    p.images_selected >= target_images,
-                    p.pairs_selected >= target_pairs,
-                );
-                (
-                    images,
-                    pairs,
-                    images && pairs && each.met(solver) == each.target,
-                )
-            };
             let reachable_images = {
                 let mut has_pair = vec![false; problem.image_costs.len()];
                 for p in &problem.pairs {
@@ -327,20 +345,43 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
             let last_useful = 2 * problem.pairs.len() as u64 - target_pairs as u64;
             let mut ever = (false, false);
             let mut found = None;
+            // What held at the F before the one examined: images, pairs, each image's pairs.
             let mut prev = (false, false, false);
+            // The caller's check: the F from which it is next evaluated, whether it ever failed,
+            // and what it achieved at its last evaluation.
+            let mut next_check = 0u64;
+            let mut check_failed = false;
+            let mut check_achieved = 0usize;
             if target_images > reachable_images {
                 // Out of reach from the start: only the image criterion is to blame.
                 ever = (false, true);
             } else {
                 loop {
                     let p = *curve.last().unwrap();
-                    let m = meets(solver, &p);
-                    ever = (ever.0 || m.0, ever.1 || m.1);
-                    if m.0 && m.1 && m.2 {
-                        found = Some(p);
-                        break;
+                    let images = p.images_selected >= target_images;
+                    let pairs = p.pairs_selected >= target_pairs;
+                    ever = (ever.0 || images, ever.1 || pairs);
+                    // The per-selection criteria are counted only once the cheap ones hold.
+                    let each_ok = images && pairs && each.met(solver) == each.target;
+                    if each_ok {
+                        match check {
+                            None => {
+                                found = Some(p);
+                                break;
+                            }
+                            Some(c) if p.flow >= next_check => {
+                                check_achieved = c.achieved(&solver.selection().pairs);
+                                if check_achieved >= c.target() {
+                                    found = Some(p);
+                                    break;
+                                }
+                                check_failed = true;
+                                next_check = p.flow + (p.flow / CHECK_STEP).max(1);
+                            }
+                            Some(_) => {}
+                        }
                     }
-                    prev = m;
+                    prev = (images, pairs, each_ok);
                     if solver.flow() >= last_useful || solver.augment().is_none() {
                         break;
                     }
@@ -373,6 +414,11 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
                         let binding = !first && prev.0 && prev.1 && !prev.2;
                         criteria.push(status("pairs_each", each.target, each.met(solver), binding));
                     }
+                    if let Some(c) = check {
+                        // Binding when the others held at F - 1 and it had failed before.
+                        let binding = !first && prev.2 && check_failed;
+                        criteria.push(status(c.name(), c.target(), check_achieved, binding));
+                    }
                     SearchResult {
                         selection: solver.selection(),
                         criteria,
@@ -397,6 +443,11 @@ fn run(solver: &mut ParametricSolver, problem: &SelectionProblem, rule: &FlowRul
                     ];
                     if each.active() {
                         criteria.push(status("pairs_each", each.target, each.target, false));
+                    }
+                    if let Some(c) = check {
+                        // The full graph meets it by definition (its target is what the full
+                        // graph has); binding when it is what failed.
+                        criteria.push(status(c.name(), c.target(), c.target(), check_failed));
                     }
                     SearchResult {
                         selection,

@@ -81,6 +81,15 @@ impl Tracks {
         }
     }
 
+    /// Keypoints of vertex `v` on tracks of at least `min_length` observations.
+    pub fn observations_on_tracks(&self, v: u32, min_length: u32) -> usize {
+        let range = self.offset[v as usize]..self.offset[v as usize + 1];
+        self.label[range]
+            .iter()
+            .filter(|&&t| self.length[t] >= min_length)
+            .count()
+    }
+
     /// Observations of every track that has any.
     pub fn lengths(&self) -> impl Iterator<Item = u32> + '_ {
         self.length.iter().copied().filter(|&l| l > 0)

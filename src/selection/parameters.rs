@@ -30,6 +30,10 @@ pub struct Parameters {
     /// The search's per-image criterion (None with a fixed flow or in older records).
     #[serde(default)]
     pub min_pairs_each: Option<f64>,
+    /// The search's track criterion: keypoints every image keeps on tracks of three or more
+    /// observations (None with a fixed flow or in older records, where it did not exist: off).
+    #[serde(default)]
+    pub min_track_observations: Option<usize>,
     /// The order the network's pair arcs follow (image_id in older records).
     #[serde(default)]
     pub order: Order,
@@ -57,6 +61,7 @@ impl Parameters {
             min_pairs_per_image: Some(c.min_pairs_per_image),
             min_pair_fraction: Some(c.min_pair_fraction),
             min_pairs_each: Some(c.min_pairs_each),
+            min_track_observations: Some(preset.min_track_observations()),
             order: Order::default(),
             image_path: None,
             keep_pairs: None,
@@ -81,6 +86,7 @@ impl Parameters {
         Options {
             min_num_matches: self.min_num_matches,
             rule: self.rule(),
+            min_track_observations: self.min_track_observations.unwrap_or(0),
             model: self.cost_model.clone(),
             unweighted_priors,
             curve_factor: 0,

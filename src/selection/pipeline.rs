@@ -16,6 +16,7 @@ use crate::selection::capture_order::{self, CaptureOrder};
 use crate::selection::overrides::{Listed, Overrides};
 use crate::selection::parameters::Parameters;
 use crate::selection::preset::Preset;
+use crate::selection::track_observations::TrackObservations;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -30,6 +31,9 @@ pub struct Options {
     pub min_num_matches: usize,
     /// How the flow F is chosen: fixed, or searched against the image and pair criteria.
     pub rule: FlowRule,
+    /// A criteria search also keeps this many keypoints of every image on feature tracks of
+    /// three or more observations ([`TrackObservations`]); 0: off.
+    pub min_track_observations: usize,
     /// The priors, their g and weights, and the fitness floor that make the arc costs.
     pub model: CostModel,
     /// Also compute the model's priors of weight 0 (they do not change the costs): for
@@ -183,8 +187,15 @@ pub fn plan_with(
         &order.by_rank(&resolved.forbidden_vertices),
         &resolved.edges,
     );
-    let mut search =
-        search::search_with_curve(&network.problem, &options.rule, options.curve_factor);
+    let tracks = (options.min_track_observations > 0
+        && matches!(options.rule, FlowRule::Criteria(_)))
+    .then(|| TrackObservations::new(&scene, &network, options.min_track_observations));
+    let mut search = search::search_with_curve(
+        &network.problem,
+        &options.rule,
+        options.curve_factor,
+        tracks.as_ref().map(|t| t as &dyn search::SelectionCheck),
+    );
     search.selection = network.expand(&search.selection);
     search.selection.images = order.by_vertex(&search.selection.images);
     timings.solve = t.elapsed().as_secs_f64();
@@ -413,6 +424,7 @@ mod tests {
             unweighted_priors: false,
             curve_factor: 0,
             capture: Default::default(),
+            min_track_observations: 0,
         };
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor
         // (0.6) already, and half of 0.4 pairs per image x 5 images is one pair.

@@ -46,6 +46,15 @@ impl Preset {
         }
     }
 
+    /// The flow search's track criterion (keypoints each image keeps on tracks of three or more
+    /// observations, [`crate::selection::track_observations`]); 0: off.
+    pub fn min_track_observations(self) -> usize {
+        match self {
+            Preset::General => 0,
+            Preset::Disambiguation | Preset::PaperDisambiguation => 0,
+        }
+    }
+
     /// The flow-search criteria.
     pub fn criteria(self) -> Criteria {
         let (min_image_fraction, min_pairs_per_image, min_pair_fraction, min_pairs_each) =
