@@ -38,7 +38,7 @@ pub struct FlowArgs {
     #[arg(long, value_parser = fraction)]
     min_image_fraction: Option<f64>,
     /// Search: ... and at least this many pairs per image (capped at all pairs)
-    /// [default: 20, disambiguation preset 5].
+    /// [default: 0, disambiguation preset 5].
     #[arg(long, value_parser = non_negative)]
     min_pairs_per_image: Option<f64>,
     /// Search: ... and at least this fraction of the view graph's pairs
@@ -50,8 +50,8 @@ pub struct FlowArgs {
     #[arg(long, value_parser = non_negative)]
     min_pairs_each: Option<f64>,
     /// Search: ... and every image keeps at least this many keypoints on feature tracks of
-    /// three or more images (all it has, if fewer), so that the mapper can register it
-    /// [default: 0 (off)].
+    /// three or more images (half of what it has, if fewer), so that the mapper can register it
+    /// [default: 100, other presets 0 (off)].
     #[arg(long)]
     min_track_observations: Option<usize>,
 }

@@ -11,7 +11,9 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "lowercase")]
 pub enum Preset {
     /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
-    /// angle, overlap, infinite homography. Search: 90% of images, 20 pairs per image.
+    /// angle, overlap, infinite homography. Search: 90% of images, and every image keeps 100
+    /// keypoints on tracks of three or more images (half of its own, if fewer): as many pairs as each
+    /// image needs to stay registrable, which adapts to how densely the images overlap.
     General,
     /// For scenes with duplicate or symmetric structure, whatever the image order: pair prior
     /// backbone tracks (the share of a pair's inliers that tracks through each image's strongest
@@ -50,7 +52,10 @@ impl Preset {
     /// observations, [`crate::selection::track_observations`]); 0: off.
     pub fn min_track_observations(self) -> usize {
         match self {
-            Preset::General => 0,
+            // COLMAP's mapper wants 100 inliers to start a model (init_min_num_inliers); chosen
+            // on castle and Herz-Jesus, judged on templeRing, lego and rendered scenes
+            // (docs/performance.md).
+            Preset::General => 100,
             Preset::Disambiguation | Preset::PaperDisambiguation => 0,
         }
     }
@@ -59,7 +64,7 @@ impl Preset {
     pub fn criteria(self) -> Criteria {
         let (min_image_fraction, min_pairs_per_image, min_pair_fraction, min_pairs_each) =
             match self {
-                Preset::General => (0.9, 20.0, 0.0, 0.0),
+                Preset::General => (0.9, 0.0, 0.0, 0.0),
                 Preset::Disambiguation => (0.8, 5.0, 0.0, 0.0),
                 Preset::PaperDisambiguation => (0.0, 0.0, 0.25, 0.0),
             };
