@@ -276,7 +276,7 @@ fn a_callers_check_is_met_within_its_step_of_the_smallest_flow() {
         let check = PairsSelected(by_cost[..3].to_vec());
         let holds = |s: &Selection| check.achieved(&s.pairs) == 3;
         let rule = criteria(0.5, 0.0);
-        let r = search_with_curve(&p, &rule, 0, Some(&check));
+        let r = search_with_curve(&p, &rule, 0, &[&check]);
         let smallest = (0..=2 * p.pairs.len() as u64).find(|&f| {
             let s = solve(&p, f);
             counts(&s).0 >= 20 && holds(&s)
@@ -311,7 +311,7 @@ fn curve_beyond_the_choice_continues_the_same_flows_and_keeps_the_selection() {
         let problem = random_problem(12, 30, seed);
         for rule in [criteria(0.6, 1.0), FlowRule::Fixed(3), criteria(1.0, 30.0)] {
             let plain = search(&problem, &rule);
-            let extended = search_with_curve(&problem, &rule, 4, None);
+            let extended = search_with_curve(&problem, &rule, 4, &[]);
             assert_eq!(extended.selection, plain.selection, "seed {seed}");
             assert_eq!(extended.curve.len(), plain.curve.len());
             // Every point, chosen or beyond, is what a fresh solver selects at that F.

@@ -76,6 +76,8 @@ fn every_image_keeps_its_long_track_keypoints() {
             "0".into(),
             "--min_pairs_per_image".into(),
             "0".into(),
+            "--biconnected".into(),
+            "false".into(),
             "-q".into(),
         ];
         args.extend(extra.iter().map(|a| a.to_string()));

@@ -31,7 +31,7 @@ impl DatabaseArg {
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations", "biconnected"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
@@ -54,6 +54,10 @@ pub struct FlowArgs {
     /// [default: 100, other presets 0 (off)].
     #[arg(long)]
     min_track_observations: Option<usize>,
+    /// Search: ... and no image cuts the selection apart: it stays connected without any one
+    /// image [default: true, other presets false].
+    #[arg(long)]
+    biconnected: Option<bool>,
 }
 
 impl FlowArgs {
@@ -74,10 +78,16 @@ impl FlowArgs {
 
     /// The track criterion: None with a fixed flow, else as given or `default`.
     pub fn track_observations(&self, default: usize) -> Option<usize> {
-        match self.flow {
-            Some(_) => None,
-            None => Some(self.min_track_observations.unwrap_or(default)),
-        }
+        self.flow
+            .is_none()
+            .then(|| self.min_track_observations.unwrap_or(default))
+    }
+
+    /// The connectivity criterion: None with a fixed flow, else as given or `default`.
+    pub fn biconnected(&self, default: bool) -> Option<bool> {
+        self.flow
+            .is_none()
+            .then(|| self.biconnected.unwrap_or(default))
     }
 
     /// The parameters' view of these options: the fixed flow, or the criteria filled from

@@ -1,8 +1,9 @@
 //! The paper's selection network and its exact min-cost flow, independent of COLMAP: the network,
-//! the parametric solver, the search over F, the plain-text graph format and synthetic graphs.
+//! the parametric solver, the search over F and its connectivity criterion, the plain-text graph format and synthetic graphs.
 
 #![warn(missing_docs)]
 
+pub mod connectivity;
 pub mod graph_file;
 pub mod network;
 pub mod search;

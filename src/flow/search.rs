@@ -7,8 +7,9 @@
 //! Targets, with n = number of images in the problem: images selected >= ceil(A n) and pairs
 //! selected >= min(max(ceil(B n), ceil(P |E|)), |E|).
 //!
-//! A caller may add a [`SelectionCheck`] computed from the selected pairs (the main crate's
-//! track criterion); it is evaluated once the targets hold, in steps (see the trait).
+//! A caller may add [`SelectionCheck`]s computed from the selected pairs
+//! ([`crate::connectivity::Biconnected`], the main crate's track criterion); they are evaluated
+//! once the other targets hold, in steps (see the trait).
 //!
 //! When no F meets both targets the full graph is kept (`capped`): every image and every pair
 //! selected, including images without pairs. Its `flow` is |E| and its `cost` is that of the
@@ -238,21 +239,21 @@ fn point(solver: &ParametricSolver) -> CurvePoint {
 /// Runs `rule` on `problem`. The curve starts at F = 0 and ends at the chosen F (for a capped
 /// criteria search: at the last F examined).
 pub fn search(problem: &SelectionProblem, rule: &FlowRule) -> SearchResult {
-    search_with_curve(problem, rule, 0, None)
+    search_with_curve(problem, rule, 0, &[])
 }
 
 /// [`search`], then the same solver goes on past the chosen F to record `beyond`: up to `factor`
 /// times that F (at most 2|E|), stopping once every pair is selected (`--plots` draws what more
 /// flow would buy). The selection stays the chosen one. `factor` 0 records nothing more.
-/// A criteria search also has to meet `check` when one is given.
+/// A criteria search also has to meet every one of `checks`.
 pub fn search_with_curve(
     problem: &SelectionProblem,
     rule: &FlowRule,
     factor: u64,
-    check: Option<&dyn SelectionCheck>,
+    checks: &[&dyn SelectionCheck],
 ) -> SearchResult {
     let mut solver = ParametricSolver::new(problem);
-    let mut result = run(&mut solver, problem, rule, check);
+    let mut result = run(&mut solver, problem, rule, checks);
     if factor > 0 {
         let end = CurveEnd::new(problem, &result, factor);
         while !end.complete(&point(&solver))
@@ -314,7 +315,7 @@ fn run(
     solver: &mut ParametricSolver,
     problem: &SelectionProblem,
     rule: &FlowRule,
-    check: Option<&dyn SelectionCheck>,
+    checks: &[&dyn SelectionCheck],
 ) -> SearchResult {
     let mut curve = vec![point(solver)];
     match *rule {
@@ -347,11 +348,11 @@ fn run(
             let mut found = None;
             // What held at the F before the one examined: images, pairs, each image's pairs.
             let mut prev = (false, false, false);
-            // The caller's check: the F from which it is next evaluated, whether it ever failed,
-            // and what it achieved at its last evaluation.
+            // The caller's checks: the F from which they are next evaluated, and for each whether
+            // it ever failed and what it achieved at its last evaluation.
             let mut next_check = 0u64;
-            let mut check_failed = false;
-            let mut check_achieved = 0usize;
+            let mut check_failed = vec![false; checks.len()];
+            let mut check_achieved = vec![0usize; checks.len()];
             if target_images > reachable_images {
                 // Out of reach from the start: only the image criterion is to blame.
                 ever = (false, true);
@@ -363,23 +364,25 @@ fn run(
                     ever = (ever.0 || images, ever.1 || pairs);
                     // The per-selection criteria are counted only once the cheap ones hold.
                     let each_ok = images && pairs && each.met(solver) == each.target;
-                    if each_ok {
-                        match check {
-                            None => {
-                                found = Some(p);
-                                break;
+                    if each_ok && p.flow >= next_check {
+                        let selected = if checks.is_empty() {
+                            Vec::new()
+                        } else {
+                            solver.selection().pairs
+                        };
+                        let mut all = true;
+                        for (k, c) in checks.iter().enumerate() {
+                            check_achieved[k] = c.achieved(&selected);
+                            if check_achieved[k] < c.target() {
+                                check_failed[k] = true;
+                                all = false;
                             }
-                            Some(c) if p.flow >= next_check => {
-                                check_achieved = c.achieved(&solver.selection().pairs);
-                                if check_achieved >= c.target() {
-                                    found = Some(p);
-                                    break;
-                                }
-                                check_failed = true;
-                                next_check = p.flow + (p.flow / CHECK_STEP).max(1);
-                            }
-                            Some(_) => {}
                         }
+                        if all {
+                            found = Some(p);
+                            break;
+                        }
+                        next_check = p.flow + (p.flow / CHECK_STEP).max(1);
                     }
                     prev = (images, pairs, each_ok);
                     if solver.flow() >= last_useful || solver.augment().is_none() {
@@ -414,10 +417,10 @@ fn run(
                         let binding = !first && prev.0 && prev.1 && !prev.2;
                         criteria.push(status("pairs_each", each.target, each.met(solver), binding));
                     }
-                    if let Some(c) = check {
+                    for (k, c) in checks.iter().enumerate() {
                         // Binding when the others held at F - 1 and it had failed before.
-                        let binding = !first && prev.2 && check_failed;
-                        criteria.push(status(c.name(), c.target(), check_achieved, binding));
+                        let binding = !first && prev.2 && check_failed[k];
+                        criteria.push(status(c.name(), c.target(), check_achieved[k], binding));
                     }
                     SearchResult {
                         selection: solver.selection(),
@@ -444,10 +447,9 @@ fn run(
                     if each.active() {
                         criteria.push(status("pairs_each", each.target, each.target, false));
                     }
-                    if let Some(c) = check {
-                        // The full graph meets it by definition (its target is what the full
-                        // graph has); binding when it is what failed.
-                        criteria.push(status(c.name(), c.target(), c.target(), check_failed));
+                    for (k, c) in checks.iter().enumerate() {
+                        // The full graph meets it (a check's contract); binding when it failed.
+                        criteria.push(status(c.name(), c.target(), c.target(), check_failed[k]));
                     }
                     SearchResult {
                         selection,

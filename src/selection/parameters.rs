@@ -34,6 +34,10 @@ pub struct Parameters {
     /// observations (None with a fixed flow or in older records, where it did not exist: off).
     #[serde(default)]
     pub min_track_observations: Option<usize>,
+    /// The search's connectivity criterion: no cut image in the selection (None with a fixed
+    /// flow or in older records: off).
+    #[serde(default)]
+    pub biconnected: Option<bool>,
     /// The order the network's pair arcs follow (image_id in older records).
     #[serde(default)]
     pub order: Order,
@@ -62,6 +66,7 @@ impl Parameters {
             min_pair_fraction: Some(c.min_pair_fraction),
             min_pairs_each: Some(c.min_pairs_each),
             min_track_observations: Some(preset.min_track_observations()),
+            biconnected: Some(preset.biconnected()),
             order: Order::default(),
             image_path: None,
             keep_pairs: None,
@@ -87,6 +92,7 @@ impl Parameters {
             min_num_matches: self.min_num_matches,
             rule: self.rule(),
             min_track_observations: self.min_track_observations.unwrap_or(0),
+            biconnected: self.biconnected.unwrap_or(false),
             model: self.cost_model.clone(),
             unweighted_priors,
             curve_factor: 0,

@@ -5,8 +5,9 @@ use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, Verified
 use crate::colmap::ids::pair_id;
 use crate::colmap::rewrite;
 use crate::costs::{self, CostModel, Costs};
+use crate::flow::connectivity::Biconnected;
 use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
-use crate::flow::search::{self, FlowRule, SearchResult};
+use crate::flow::search::{self, FlowRule, SearchResult, SelectionCheck};
 use crate::geometry::camera::CameraModel;
 use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, PriorValues};
@@ -34,6 +35,8 @@ pub struct Options {
     /// A criteria search also keeps this many keypoints of every image on feature tracks of
     /// three or more observations ([`TrackObservations`]); 0: off.
     pub min_track_observations: usize,
+    /// A criteria search also keeps the selection free of cut images ([`Biconnected`]).
+    pub biconnected: bool,
     /// The priors, their g and weights, and the fitness floor that make the arc costs.
     pub model: CostModel,
     /// Also compute the model's priors of weight 0 (they do not change the costs): for
@@ -187,14 +190,22 @@ pub fn plan_with(
         &order.by_rank(&resolved.forbidden_vertices),
         &resolved.edges,
     );
-    let tracks = (options.min_track_observations > 0
-        && matches!(options.rule, FlowRule::Criteria(_)))
-    .then(|| TrackObservations::new(&scene, &network, options.min_track_observations));
+    let searched = matches!(options.rule, FlowRule::Criteria(_));
+    let biconnected = (searched && options.biconnected).then(|| Biconnected::new(&network.problem));
+    let tracks = (searched && options.min_track_observations > 0)
+        .then(|| TrackObservations::new(&scene, &network, options.min_track_observations));
+    let mut checks: Vec<&dyn SelectionCheck> = Vec::new();
+    if let Some(b) = &biconnected {
+        checks.push(b);
+    }
+    if let Some(t) = &tracks {
+        checks.push(t);
+    }
     let mut search = search::search_with_curve(
         &network.problem,
         &options.rule,
         options.curve_factor,
-        tracks.as_ref().map(|t| t as &dyn search::SelectionCheck),
+        &checks,
     );
     search.selection = network.expand(&search.selection);
     search.selection.images = order.by_vertex(&search.selection.images);
@@ -425,6 +436,7 @@ mod tests {
             curve_factor: 0,
             capture: Default::default(),
             min_track_observations: 0,
+            biconnected: false,
         };
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor
         // (0.6) already, and half of 0.4 pairs per image x 5 images is one pair.

@@ -13,7 +13,8 @@ pub enum Preset {
     /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
     /// angle, overlap, infinite homography. Search: 90% of images, and every image keeps 100
     /// keypoints on tracks of three or more images (half of its own, if fewer): as many pairs as each
-    /// image needs to stay registrable, which adapts to how densely the images overlap.
+    /// image needs to stay registrable, which adapts to how densely the images overlap; and no
+    /// image whose removal would cut the selection apart.
     General,
     /// For scenes with duplicate or symmetric structure, whatever the image order: pair prior
     /// backbone tracks (the share of a pair's inliers that tracks through each image's strongest
@@ -58,6 +59,12 @@ impl Preset {
             Preset::General => 100,
             Preset::Disambiguation | Preset::PaperDisambiguation => 0,
         }
+    }
+
+    /// Whether the flow search also asks for a selection without cut images
+    /// ([`crate::flow::connectivity::Biconnected`]).
+    pub fn biconnected(self) -> bool {
+        self == Preset::General
     }
 
     /// The flow-search criteria.

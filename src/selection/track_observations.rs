@@ -37,7 +37,11 @@ impl<'a> TrackObservations<'a> {
     pub fn new(scene: &'a Scene<'a>, restriction: &'a Restriction, n: usize) -> Self {
         let full = Tracks::build(scene, |_| true);
         let need: Vec<usize> = (0..scene.graph.num_vertices() as u32)
-            .map(|v| full.observations_on_tracks(v, MIN_TRACK_LENGTH).div_ceil(2).min(n))
+            .map(|v| {
+                full.observations_on_tracks(v, MIN_TRACK_LENGTH)
+                    .div_ceil(2)
+                    .min(n)
+            })
             .collect();
         let target = need.iter().filter(|&&k| k > 0).count();
         TrackObservations {
