@@ -55,7 +55,7 @@ pub struct FlowArgs {
     #[arg(long)]
     min_track_observations: Option<usize>,
     /// Search: ... and no image cuts the selection apart: it stays connected without any one
-    /// image [default: true, other presets false].
+    /// image [default: false].
     #[arg(long)]
     biconnected: Option<bool>,
 }
