@@ -1,5 +1,6 @@
 //! Flow search: exact smallest F meeting the criteria, capped fallback, fixed F, degenerate input.
 
+use vgsel_colmap::flow::connectivity::Biconnected;
 use vgsel_colmap::flow::network::{Selection, SelectionProblem};
 use vgsel_colmap::flow::search::{
     search, search_with_curve, targets, Criteria, FlowRule, SearchResult, SelectionCheck,
@@ -303,6 +304,73 @@ fn a_callers_check_is_met_within_its_step_of_the_smallest_flow() {
         // Without the check the same rule stops no later.
         assert!(search(&p, &rule).selection.flow <= r.selection.flow);
     }
+}
+
+/// Connected and without a cut vertex, by removing each selected image in turn (independent of
+/// the library's low-point test).
+fn biconnected_by_brute_force(p: &SelectionProblem, s: &Selection) -> bool {
+    let edges: Vec<(u32, u32)> = p
+        .pairs
+        .iter()
+        .zip(&s.pairs)
+        .filter(|(_, &on)| on)
+        .map(|(a, _)| (a.i, a.j))
+        .collect();
+    let vertices: std::collections::BTreeSet<u32> =
+        edges.iter().flat_map(|&(i, j)| [i, j]).collect();
+    let connected_without = |skip: Option<u32>| {
+        let left: Vec<u32> = vertices
+            .iter()
+            .copied()
+            .filter(|&v| Some(v) != skip)
+            .collect();
+        let mut seen = std::collections::BTreeSet::from([left[0]]);
+        let mut todo = vec![left[0]];
+        while let Some(v) = todo.pop() {
+            for &(i, j) in &edges {
+                for (a, b) in [(i, j), (j, i)] {
+                    if a == v && Some(b) != skip && seen.insert(b) {
+                        todo.push(b);
+                    }
+                }
+            }
+        }
+        seen.len() == left.len()
+    };
+    !vertices.is_empty()
+        && connected_without(None)
+        && (vertices.len() < 3 || vertices.iter().all(|&v| connected_without(Some(v))))
+}
+
+#[test]
+fn a_biconnected_search_has_no_cut_image() {
+    let mut checked = 0;
+    for seed in 20..30u64 {
+        let p = random_problem(30, 120, seed);
+        let check = Biconnected::new(&p);
+        let rule = criteria(0.6, 0.0);
+        let r = search_with_curve(&p, &rule, 0, &[&check]);
+        let smallest = (0..=2 * p.pairs.len() as u64).find(|&f| {
+            let s = solve(&p, f);
+            counts(&s).0 >= 18 && biconnected_by_brute_force(&p, &s)
+        });
+        match smallest {
+            Some(f0) => {
+                let f = r.selection.flow;
+                assert!(biconnected_by_brute_force(&p, &r.selection), "seed {seed}");
+                assert!(
+                    f >= f0 && f <= f0 + (f0 / 32).max(1),
+                    "seed {seed}: F {f}, smallest {f0}"
+                );
+                checked += 1;
+            }
+            None => assert!(r.capped, "seed {seed}"),
+        }
+    }
+    assert!(
+        checked >= 5,
+        "only {checked} problems had a biconnected selection"
+    );
 }
 
 #[test]
