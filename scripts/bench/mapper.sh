@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Benchmark: `colmap mapper` on the full and on the pruned database of each scene (prune's defaults),
 # interleaved, RUNS runs each; prints medians of mapper seconds, their ratio, registered and correct
-# cameras, and median position / rotation errors against the ground truth (`vgsel-colmap eval`).
+# cameras, and median position / rotation errors against the ground truth (`vgsel-colmap eval`);
+# the same table in Markdown, as the README shows it, goes to WORK/table.md.
 #
 # usage: scripts/bench/mapper.sh [SCENE...]     (default: lego room100 herzjesus castle templering)
 #   scenes: lego herzjesus castle templering fountain (shared datasets with ground truth),

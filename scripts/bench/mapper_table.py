@@ -4,7 +4,7 @@ the pruned database, and the verdict of issue 15 on the pruned one (at least 2x 
 time, no fewer registered or correct cameras, median errors within 1.5x of the full model's).
 
 usage: mapper_table.py WORK RUNS SCENE...   (reads WORK/SCENE/{prune.json,MAPPER/VARIANT/RUN/};
-writes WORK/summary.json)
+writes WORK/summary.json and the same table in Markdown, as the README shows it, to WORK/table.md)
 """
 import json
 import os
@@ -53,11 +53,26 @@ def verdict(full, pruned, ratio):
     return ", ".join(problems) or "pass"
 
 
+def fmt(value, spec):
+    return "-" if value is None else spec % value
+
+
+def markdown_row(scene, mapper, pairs, full, pruned, ratio, why):
+    """One README row: full -> pruned for each measure."""
+    arrow = lambda key, spec: f"{fmt(full[key], spec)} → {fmt(pruned[key], spec)}"
+    return (f"| {scene} | {mapper} | {pairs['full']} → {pairs['pruned']} | "
+            f"{arrow('cpu', '%.1f')} | {ratio:.2f}x | {arrow('registered', '%g')} | "
+            f"{arrow('correct', '%g')} | {arrow('pos', '%.1e')} | {arrow('rot', '%.2f')} | {why} |")
+
+
 def main():
     work, runs, scenes = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
     print(f"{'scene':<10} {'mapper':<8} {'db':<6} {'pairs':>5} {'wall s':>7} {'CPU s':>7} "
           f"{'ratio':>5} {'registered':>10} {'correct':>7} {'med. pos':>8} {'med. rot':>8}  verdict")
     summary = {}
+    markdown = ["| scene | mapper | pairs full → pruned | CPU s full → pruned | ratio | registered | "
+                "correct | med. pos. error | med. rot. error | verdict |",
+                "|---|---|---|---|---|---|---|---|---|---|"]
     for scene in scenes:
         base = f"{work}/{scene}"
         if not os.path.exists(f"{base}/prune.json"):
@@ -83,6 +98,7 @@ def main():
                       f"{'%g/%d' % (r['registered'], r['images']):>10} {r['correct']:>7g} "
                       f"{'-' if r['pos'] is None else '%.1e' % r['pos']:>8} "
                       f"{'-' if r['rot'] is None else '%.3f' % r['rot']:>8}  {why if last else ''}")
+            markdown.append(markdown_row(scene, mapper, pairs, full, pruned, ratio, why))
             binding = [c for c in prune["criteria"] if c.get("binding")]
             summary[f"{scene}/{mapper}"] = {
                 "pairs": pairs, "flow": prune["flow"], "cpu_ratio": ratio, "verdict": why,
@@ -90,6 +106,7 @@ def main():
     print(f"(medians of {runs} interleaved runs; ratio = full / pruned CPU seconds; positions as "
           f"fractions of the ground truth's extent, rotations in degrees; files: {work})")
     json.dump(summary, open(f"{work}/summary.json", "w"), indent=1)
+    open(f"{work}/table.md", "w").write("\n".join(markdown) + "\n")
 
 
 main()
