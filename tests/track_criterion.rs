@@ -116,3 +116,57 @@ fn every_image_keeps_its_long_track_keypoints() {
         );
     }
 }
+
+#[test]
+fn a_forbidden_image_does_not_stop_the_search() {
+    // Its pairs can never be selected, so it needs nothing; the others still get theirs.
+    let (dir, db) = scene();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let names: Vec<String> = {
+        let conn = Connection::open(&db).unwrap();
+        let mut stmt = conn
+            .prepare("SELECT name FROM images ORDER BY image_id")
+            .unwrap();
+        let rows = stmt.query_map([], |r| r.get(0)).unwrap();
+        rows.map(Result::unwrap).collect()
+    };
+    let forbid = dir.path().join("forbid.txt");
+    std::fs::write(&forbid, format!("{}\n", names[3])).unwrap();
+    let (out, report) = (dir.path().join("out.db"), dir.path().join("r.json"));
+    ok(&[
+        "prune",
+        "--database_path",
+        &s(&db),
+        "--output",
+        &s(&out),
+        "--report",
+        &s(&report),
+        "--forbid_images",
+        &s(&forbid),
+        "--min_track_observations",
+        "100",
+        "-q",
+    ]);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    assert_eq!(report["capped"], false, "{report}");
+    assert!(report["pairs_selected"].as_u64() < report["pairs_total"].as_u64());
+    let kept = long_track_keypoints(&out);
+    assert!(
+        !kept.contains_key(&4),
+        "the forbidden image (id 4) keeps a pair"
+    );
+    // Needs of the others, from every pair not touching the forbidden image.
+    let conn = Connection::open(&db).unwrap();
+    conn.execute_batch(
+        "PRAGMA foreign_keys = OFF; \
+         DELETE FROM two_view_geometries WHERE pair_id / 2147483647 = 4 OR pair_id % 2147483647 = 4;",
+    )
+    .unwrap();
+    drop(conn);
+    let selectable = long_track_keypoints(&db);
+    for (v, &f) in &selectable {
+        let need = f.div_ceil(2).min(100);
+        assert!(kept.get(v).copied().unwrap_or(0) >= need, "image {v}");
+    }
+}

@@ -1,7 +1,8 @@
 //! The search criterion that keeps every image registrable: each image keeps, on feature tracks
 //! of at least three observations, at least N of its keypoints, or half of those it has on such
-//! tracks in the full view graph if that is fewer (asking an image with few tracks for all of
-//! them would keep every one of its pairs: on lego it kept 888 of 891).
+//! tracks through the pairs the search may select (all, less those forbidden or below the fitness
+//! floor) if that is fewer: asking an image with few tracks for all of them would keep every one
+//! of its pairs (on lego, 888 of 891).
 //!
 //! Why tracks of three: the mapper registers an image from 2D-3D matches, and a point exists
 //! only once two other registered images observe it, so only a keypoint whose track (through the
@@ -23,8 +24,8 @@ pub const MIN_TRACK_LENGTH: u32 = 3;
 pub struct TrackObservations<'a> {
     scene: &'a Scene<'a>,
     restriction: &'a Restriction,
-    /// Keypoints each vertex must keep on long tracks: min(N, half of what the full graph gives
-    /// it, rounded up).
+    /// Keypoints each vertex must keep on long tracks: min(N, half of what the selectable pairs
+    /// give it, rounded up).
     need: Vec<usize>,
     /// Vertices that need any.
     target: usize,
@@ -32,10 +33,13 @@ pub struct TrackObservations<'a> {
 
 impl<'a> TrackObservations<'a> {
     /// Each vertex of `scene` needs `n` keypoints on tracks of [`MIN_TRACK_LENGTH`] or more
-    /// observations (half of what it has on them in the full graph, if fewer); `restriction`
-    /// maps the search's pairs to the view graph's edges.
+    /// observations (half of what it has on them through every pair the search may select, if
+    /// fewer); `restriction` maps the search's pairs to the view graph's edges.
     pub fn new(scene: &'a Scene<'a>, restriction: &'a Restriction, n: usize) -> Self {
-        let full = Tracks::build(scene, |_| true);
+        // What the search can reach: forbidden images, forbidden pairs and pairs below the
+        // fitness floor never count, or their images could never meet the need.
+        let selectable = restriction.expand_pairs(&vec![true; restriction.problem.pairs.len()]);
+        let full = Tracks::build(scene, |e| selectable[e]);
         let need: Vec<usize> = (0..scene.graph.num_vertices() as u32)
             .map(|v| {
                 full.observations_on_tracks(v, MIN_TRACK_LENGTH)
