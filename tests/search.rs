@@ -1,6 +1,6 @@
 //! Flow search: exact smallest F meeting the criteria, capped fallback, fixed F, degenerate input.
 
-use vgsel_colmap::flow::connectivity::Biconnected;
+use vgsel_colmap::flow::connectivity::{is_biconnected, Biconnected};
 use vgsel_colmap::flow::network::{Selection, SelectionProblem};
 use vgsel_colmap::flow::search::{
     search, search_with_curve, targets, Criteria, FlowRule, SearchResult, SelectionCheck,
@@ -306,16 +306,9 @@ fn a_callers_check_is_met_within_its_step_of_the_smallest_flow() {
     }
 }
 
-/// Connected and without a cut vertex, by removing each selected image in turn (independent of
-/// the library's low-point test).
-fn biconnected_by_brute_force(p: &SelectionProblem, s: &Selection) -> bool {
-    let edges: Vec<(u32, u32)> = p
-        .pairs
-        .iter()
-        .zip(&s.pairs)
-        .filter(|(_, &on)| on)
-        .map(|(a, _)| (a.i, a.j))
-        .collect();
+/// Whether the graph of `edges` is connected and stays connected without any one of its
+/// vertices (three or more), by removing each in turn: independent of the library's low points.
+fn biconnected_by_brute_force(edges: &[(u32, u32)]) -> bool {
     let vertices: std::collections::BTreeSet<u32> =
         edges.iter().flat_map(|&(i, j)| [i, j]).collect();
     let connected_without = |skip: Option<u32>| {
@@ -327,7 +320,7 @@ fn biconnected_by_brute_force(p: &SelectionProblem, s: &Selection) -> bool {
         let mut seen = std::collections::BTreeSet::from([left[0]]);
         let mut todo = vec![left[0]];
         while let Some(v) = todo.pop() {
-            for &(i, j) in &edges {
+            for &(i, j) in edges {
                 for (a, b) in [(i, j), (j, i)] {
                     if a == v && Some(b) != skip && seen.insert(b) {
                         todo.push(b);
@@ -342,6 +335,51 @@ fn biconnected_by_brute_force(p: &SelectionProblem, s: &Selection) -> bool {
         && (vertices.len() < 3 || vertices.iter().all(|&v| connected_without(Some(v))))
 }
 
+/// The selected pairs as edges.
+fn selected_edges(p: &SelectionProblem, s: &Selection) -> Vec<(u32, u32)> {
+    p.pairs
+        .iter()
+        .zip(&s.pairs)
+        .filter(|(_, &on)| on)
+        .map(|(a, _)| (a.i, a.j))
+        .collect()
+}
+
+#[test]
+fn biconnectivity_agrees_with_brute_force_on_random_graphs() {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move |m: u64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state % m
+    };
+    let (mut yes, mut no) = (0, 0);
+    for _ in 0..3000 {
+        let n = 2 + next(8) as usize;
+        let m = next(2 * n as u64 + 1) as usize;
+        let mut edges = Vec::new();
+        for _ in 0..m {
+            let (a, b) = (next(n as u64) as u32, next(n as u64) as u32);
+            if a != b && !edges.contains(&(a.min(b), a.max(b))) {
+                edges.push((a.min(b), a.max(b)));
+            }
+        }
+        let expected = biconnected_by_brute_force(&edges);
+        assert_eq!(
+            is_biconnected(n, &edges),
+            expected,
+            "{n} vertices, {edges:?}"
+        );
+        if expected {
+            yes += 1
+        } else {
+            no += 1
+        }
+    }
+    assert!(yes > 300 && no > 300, "{yes} biconnected, {no} not");
+}
+
 #[test]
 fn a_biconnected_search_has_no_cut_image() {
     let mut checked = 0;
@@ -352,12 +390,15 @@ fn a_biconnected_search_has_no_cut_image() {
         let r = search_with_curve(&p, &rule, 0, &[&check]);
         let smallest = (0..=2 * p.pairs.len() as u64).find(|&f| {
             let s = solve(&p, f);
-            counts(&s).0 >= 18 && biconnected_by_brute_force(&p, &s)
+            counts(&s).0 >= 18 && biconnected_by_brute_force(&selected_edges(&p, &s))
         });
         match smallest {
             Some(f0) => {
                 let f = r.selection.flow;
-                assert!(biconnected_by_brute_force(&p, &r.selection), "seed {seed}");
+                assert!(
+                    biconnected_by_brute_force(&selected_edges(&p, &r.selection)),
+                    "seed {seed}"
+                );
                 assert!(
                     f >= f0 && f <= f0 + (f0 / 32).max(1),
                     "seed {seed}: F {f}, smallest {f0}"

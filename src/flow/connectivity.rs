@@ -99,86 +99,10 @@ pub fn is_biconnected(num_vertices: usize, edges: &[(u32, u32)]) -> bool {
     visited == touched && root_children <= 1
 }
 
+/// Compared with a brute-force test on random graphs in tests/search.rs.
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Brute force: connected, and connected without each vertex in turn.
-    fn brute(n: usize, edges: &[(u32, u32)]) -> bool {
-        let connected_without = |skip: Option<u32>| {
-            let kept: Vec<_> = edges
-                .iter()
-                .filter(|&&(i, j)| Some(i) != skip && Some(j) != skip)
-                .collect();
-            let mut touched: Vec<bool> = vec![false; n];
-            for &&(i, j) in &edges.iter().collect::<Vec<_>>() {
-                touched[i as usize] = true;
-                touched[j as usize] = true;
-            }
-            if let Some(s) = skip {
-                touched[s as usize] = false;
-            }
-            let Some(start) = touched.iter().position(|&t| t) else {
-                return true;
-            };
-            let mut seen = vec![false; n];
-            let mut todo = vec![start];
-            seen[start] = true;
-            while let Some(v) = todo.pop() {
-                for &&(i, j) in &kept {
-                    for (a, b) in [(i, j), (j, i)] {
-                        if a as usize == v && !seen[b as usize] {
-                            seen[b as usize] = true;
-                            todo.push(b as usize);
-                        }
-                    }
-                }
-            }
-            (0..n).all(|v| !touched[v] || seen[v])
-        };
-        if edges.is_empty() {
-            return false;
-        }
-        let vertices: std::collections::BTreeSet<u32> =
-            edges.iter().flat_map(|&(i, j)| [i, j]).collect();
-        connected_without(None)
-            && (vertices.len() < 3 || vertices.iter().all(|&v| connected_without(Some(v))))
-    }
-
-    #[test]
-    fn agrees_with_brute_force_on_random_graphs() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move |m: u64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state % m
-        };
-        let (mut yes, mut no) = (0, 0);
-        for _ in 0..3000 {
-            let n = 2 + next(8) as usize;
-            let m = next(2 * n as u64 + 1) as usize;
-            let mut edges = Vec::new();
-            for _ in 0..m {
-                let (a, b) = (next(n as u64) as u32, next(n as u64) as u32);
-                if a != b && !edges.contains(&(a.min(b), a.max(b))) {
-                    edges.push((a.min(b), a.max(b)));
-                }
-            }
-            let expected = brute(n, &edges);
-            assert_eq!(
-                is_biconnected(n, &edges),
-                expected,
-                "{n} vertices, {edges:?}"
-            );
-            if expected {
-                yes += 1
-            } else {
-                no += 1
-            }
-        }
-        assert!(yes > 300 && no > 300, "{yes} biconnected, {no} not");
-    }
 
     #[test]
     fn chain_ring_and_bowtie() {
