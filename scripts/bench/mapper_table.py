@@ -96,8 +96,7 @@ def main():
                 print(f"{scene:<10} {mapper:<8} {variant:<6} {pairs[variant]:>5} {r['wall']:>7.1f} "
                       f"{r['cpu']:>7.1f} {'%.2f' % ratio if last else '':>5} "
                       f"{'%g/%d' % (r['registered'], r['images']):>10} {r['correct']:>7g} "
-                      f"{'-' if r['pos'] is None else '%.1e' % r['pos']:>8} "
-                      f"{'-' if r['rot'] is None else '%.3f' % r['rot']:>8}  {why if last else ''}")
+                      f"{fmt(r['pos'], '%.1e'):>8} {fmt(r['rot'], '%.3f'):>8}  {why if last else ''}")
             markdown.append(markdown_row(scene, mapper, pairs, full, pruned, ratio, why))
             binding = [c for c in prune["criteria"] if c.get("binding")]
             summary[f"{scene}/{mapper}"] = {

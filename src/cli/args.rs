@@ -83,11 +83,13 @@ impl FlowArgs {
             .then(|| self.min_track_observations.unwrap_or(default))
     }
 
-    /// The connectivity criterion: None with a fixed flow, else as given or `default`.
-    pub fn biconnected(&self, default: bool) -> Option<bool> {
+    /// The connectivity criterion: None with a fixed flow, else as given; off by default in
+    /// every preset, as on the scenes measured it kept more pairs and less accurate models
+    /// (docs/performance.md).
+    pub fn biconnected(&self) -> Option<bool> {
         self.flow
             .is_none()
-            .then(|| self.biconnected.unwrap_or(default))
+            .then(|| self.biconnected.unwrap_or(false))
     }
 
     /// The parameters' view of these options: the fixed flow, or the criteria filled from

@@ -144,7 +144,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         min_track_observations: args
             .flow
             .track_observations(args.preset.min_track_observations()),
-        biconnected: args.flow.biconnected(args.preset.biconnected()),
+        biconnected: args.flow.biconnected(),
         order: args.order,
         image_path: path_text(&args.image_path),
         keep_pairs: path_text(&args.keep_pairs),

@@ -1,5 +1,6 @@
 //! The paper's selection network and its exact min-cost flow, independent of COLMAP: the network,
-//! the parametric solver, the search over F and its connectivity criterion, the plain-text graph format and synthetic graphs.
+//! the parametric solver, the search over F and its connectivity criterion, the plain-text graph
+//! format and synthetic graphs.
 
 #![warn(missing_docs)]
 

@@ -66,7 +66,7 @@ impl Parameters {
             min_pair_fraction: Some(c.min_pair_fraction),
             min_pairs_each: Some(c.min_pairs_each),
             min_track_observations: Some(preset.min_track_observations()),
-            biconnected: Some(preset.biconnected()),
+            biconnected: Some(false),
             order: Order::default(),
             image_path: None,
             keep_pairs: None,

@@ -60,13 +60,6 @@ impl Preset {
         }
     }
 
-    /// Whether the flow search also asks for a selection without cut images
-    /// ([`crate::flow::connectivity::Biconnected`]): no preset does, as on the scenes measured
-    /// it kept more pairs and the models were less accurate, not more (docs/performance.md).
-    pub fn biconnected(self) -> bool {
-        false
-    }
-
     /// The flow-search criteria.
     pub fn criteria(self) -> Criteria {
         let (min_image_fraction, min_pairs_per_image, min_pair_fraction, min_pairs_each) =
