@@ -28,6 +28,7 @@ fn guessed_focal_length_is_replaced_by_the_estimate() {
         curve_factor: 0,
         capture: Default::default(),
         min_track_observations: 0,
+        min_track_length_ratio: 0.0,
         biconnected: false,
     };
     let p = plan(&db, &options, &|_| {}).unwrap();

@@ -42,6 +42,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         curve_factor: 0,
         capture: Default::default(),
         min_track_observations: 0,
+        min_track_length_ratio: 0.0,
         biconnected: false,
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();

@@ -1,15 +1,18 @@
-//! `--min_track_observations`: after a prune every image keeps at least N keypoints (half of
-//! what it had, if fewer) on feature tracks of three or more observations, counted here
-//! independently from the inlier matches the pruned database still holds valid.
+//! The track completion, judged on the pruned database: with `--min_track_observations N` every
+//! image keeps at least N keypoints (half of what it had, if fewer) on feature tracks of three or
+//! more observations, and with `--min_track_length_ratio R` the mean track length a keypoint
+//! sees is at least R times the full database's; both counted here independently from the
+//! inlier matches the pruned database still holds valid.
 
 use crate::support::{ok, scene};
 use rusqlite::Connection;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// Each image's keypoints on tracks of >= 3 observations, over the pairs the database holds
-/// valid with at least 15 inliers (config > 1; the mapper's and prune's min_num_matches).
-fn long_track_keypoints(db: &Path) -> HashMap<u32, usize> {
+/// Each image's keypoints on tracks of >= 3 observations, and the mean track length a keypoint
+/// on a track sees (sum of s² / sum of s), over the pairs the database holds valid with at least
+/// 15 inliers (config > 1; the mapper's and prune's min_num_matches).
+fn tracks(db: &Path) -> (HashMap<u32, usize>, f64) {
     let conn = Connection::open(db).unwrap();
     let mut stmt = conn
         .prepare(
@@ -52,7 +55,13 @@ fn long_track_keypoints(db: &Path) -> HashMap<u32, usize> {
             *per_image.entry(k.0).or_default() += 1;
         }
     }
-    per_image
+    let s1: usize = size.values().sum();
+    let s2: usize = size.values().map(|s| s * s).sum();
+    (per_image, s2 as f64 / s1 as f64)
+}
+
+fn long_track_keypoints(db: &Path) -> HashMap<u32, usize> {
+    tracks(db).0
 }
 
 #[test]
@@ -91,29 +100,84 @@ fn every_image_keeps_its_long_track_keypoints() {
             .filter(|(v, &f)| kept.get(v).copied().unwrap_or(0) < f.div_ceil(2).min(n))
             .count()
     };
-    // Without the criterion the smallest selection leaves images short of it, so the test below
+    let only = |n: usize| {
+        vec![
+            "--min_track_observations".to_string(),
+            n.to_string(),
+            "--min_track_length_ratio".into(),
+            "0".into(),
+        ]
+    };
+    fn args(v: &[String]) -> Vec<&str> {
+        v.iter().map(String::as_str).collect()
+    }
+    // Without the completion the flow's selection leaves images short of it, so the test below
     // is not met by accident.
-    let (plain, _) = prune("plain.db", &["--min_track_observations", "0"]);
+    let (plain, report) = prune("plain.db", &args(&only(0)));
     assert!(short_of(&plain, 400) > 0);
+    assert!(report["completion"].is_null());
     for n in [100, 400] {
-        let (kept, report) = prune(
-            &format!("n{n}.db"),
-            &["--min_track_observations", &n.to_string()],
-        );
+        let (kept, report) = prune(&format!("n{n}.db"), &args(&only(n)));
         assert_eq!(short_of(&kept, n), 0, "N = {n}");
-        let status = report["criteria"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["name"] == "track_observations")
-            .unwrap();
-        assert_eq!(status["target"], 16.0);
-        assert_eq!(status["achieved"], 16.0);
+        let c = &report["completion"];
+        assert!(c["images_short"].as_u64().unwrap() > 0, "{c}");
+        assert_eq!(
+            c["pairs_from_flow"].as_u64().unwrap() + c["pairs_added_for_images"].as_u64().unwrap(),
+            report["pairs_selected"].as_u64().unwrap()
+        );
         assert_eq!(report["capped"], false);
         assert!(
             report["pairs_selected"].as_u64() < report["pairs_total"].as_u64(),
             "N = {n}: nothing pruned"
         );
+    }
+}
+
+#[test]
+fn the_track_length_reaches_its_share_of_the_full_graphs() {
+    let (dir, db) = scene();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (_, full) = tracks(&db);
+    let prune = |ratio: &str| {
+        let out = dir.path().join(format!("r{ratio}.db"));
+        let report = dir.path().join(format!("r{ratio}.json"));
+        ok(&[
+            "prune",
+            "--database_path",
+            &s(&db),
+            "--output",
+            &s(&out),
+            "--report",
+            &s(&report),
+            "--min_image_fraction",
+            "0.5",
+            "--min_track_observations",
+            "0",
+            "--min_track_length_ratio",
+            ratio,
+            "-q",
+        ]);
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+        (tracks(&out).1, report)
+    };
+    let (plain, _) = prune("0");
+    for ratio in [0.9, 0.95] {
+        // Not met by the flow alone, so the completion has to add pairs.
+        assert!(plain < ratio * full, "{plain} vs {ratio} x {full}");
+        let (length, report) = prune(&ratio.to_string());
+        assert!(length >= ratio * full, "ratio {ratio}: {length} vs {full}");
+        let c = &report["completion"];
+        assert!(c["pairs_added_for_track_length"].as_u64().unwrap() > 0);
+        assert!(
+            (c["track_length"].as_f64().unwrap() - length).abs() < 1e-9,
+            "{c}"
+        );
+        assert!(
+            (c["track_length_full"].as_f64().unwrap() - full).abs() < 1e-9,
+            "{c}"
+        );
+        assert!(report["pairs_selected"].as_u64() < report["pairs_total"].as_u64());
     }
 }
 

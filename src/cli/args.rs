@@ -31,7 +31,7 @@ impl DatabaseArg {
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations", "biconnected"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations", "min_track_length_ratio", "biconnected"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
@@ -49,11 +49,15 @@ pub struct FlowArgs {
     /// fewer) [default: 0 (off)].
     #[arg(long, value_parser = non_negative)]
     min_pairs_each: Option<f64>,
-    /// Search: ... and every image keeps at least this many keypoints on feature tracks of
-    /// three or more images (half of what it has, if fewer), so that the mapper can register it
-    /// [default: 100, other presets 0 (off)].
+    /// After the search, pairs are added until every image keeps at least this many keypoints
+    /// on feature tracks of three or more images (half of what it has, if fewer), so that the
+    /// mapper can register it [default: 100, other presets 0 (off)].
     #[arg(long)]
     min_track_observations: Option<usize>,
+    /// ... and until the mean length of the feature tracks is at least this share of the full
+    /// view graph's, which the cameras' accuracy depends on [default: 0.7, other presets 0 (off)].
+    #[arg(long, value_parser = fraction)]
+    min_track_length_ratio: Option<f64>,
     /// Search: ... and no image cuts the selection apart: it stays connected without any one
     /// image [default: false].
     #[arg(long)]
@@ -81,6 +85,13 @@ impl FlowArgs {
         self.flow
             .is_none()
             .then(|| self.min_track_observations.unwrap_or(default))
+    }
+
+    /// The track completion's length ratio: None with a fixed flow, else as given or `default`.
+    pub fn track_length_ratio(&self, default: f64) -> Option<f64> {
+        self.flow
+            .is_none()
+            .then(|| self.min_track_length_ratio.unwrap_or(default))
     }
 
     /// The connectivity criterion: None with a fixed flow, else as given; off by default in

@@ -144,6 +144,9 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         min_track_observations: args
             .flow
             .track_observations(args.preset.min_track_observations()),
+        min_track_length_ratio: args
+            .flow
+            .track_length_ratio(args.preset.min_track_length_ratio()),
         biconnected: args.flow.biconnected(),
         order: args.order,
         image_path: path_text(&args.image_path),

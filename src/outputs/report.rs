@@ -5,6 +5,7 @@ use crate::scene::view_graph::{GraphStats, ViewGraph};
 use crate::selection::overrides::Listed;
 use crate::selection::parameters::Parameters;
 use crate::selection::pipeline::{Plan, Timings};
+use crate::selection::track_completion::Completion;
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -57,6 +58,8 @@ pub struct Report {
     pub graph_after: GraphStats,
     /// Of the flow's selection, before kept pairs are added (see docs/report.md).
     pub criteria: Vec<CriterionStatus>,
+    /// The pairs the track completion added after the flow (null when it did not run).
+    pub completion: Option<Completion>,
     /// Mean fitness of each prior, image priors first, to show what the selection favoured.
     pub priors: Vec<PriorSummary>,
     /// The overrides applied, by name.
@@ -192,6 +195,7 @@ impl Report {
             graph_before: plan.graph.stats(),
             graph_after: after.stats(),
             criteria: plan.search.criteria.clone(),
+            completion: plan.completion.clone(),
             priors,
             overrides: plan.overrides.clone(),
             order: OrderReport {
@@ -234,6 +238,19 @@ impl Report {
             self.images_in_view_graph,
             self.flow,
         );
+        if let Some(c) = &self.completion {
+            s += &format!(
+                "track completion: the flow kept {} pairs; {} added for {} images short of \
+                 keypoints on tracks, {} for the track length ({:.1} -> {:.1}; full graph {:.1})\n",
+                c.pairs_from_flow,
+                c.pairs_added_for_images,
+                c.images_short,
+                c.pairs_added_for_track_length,
+                c.track_length_flow,
+                c.track_length,
+                c.track_length_full,
+            );
+        }
         s += &format!(
             "components: {} before, {} after; {} pairs invalidated{}",
             self.graph_before.components,

@@ -6,4 +6,4 @@ pub mod overrides;
 pub mod parameters;
 pub mod pipeline;
 pub mod preset;
-pub mod track_observations;
+pub mod track_completion;

@@ -30,10 +30,14 @@ pub struct Parameters {
     /// The search's per-image criterion (None with a fixed flow or in older records).
     #[serde(default)]
     pub min_pairs_each: Option<f64>,
-    /// The search's track criterion: keypoints every image keeps on tracks of three or more
+    /// The track completion: keypoints every image keeps on tracks of three or more
     /// observations (None with a fixed flow or in older records, where it did not exist: off).
     #[serde(default)]
     pub min_track_observations: Option<usize>,
+    /// The track completion's share of the full graph's mean track length (None with a fixed
+    /// flow or in older records: off).
+    #[serde(default)]
+    pub min_track_length_ratio: Option<f64>,
     /// The search's connectivity criterion: no cut image in the selection (None with a fixed
     /// flow or in older records: off).
     #[serde(default)]
@@ -66,6 +70,7 @@ impl Parameters {
             min_pair_fraction: Some(c.min_pair_fraction),
             min_pairs_each: Some(c.min_pairs_each),
             min_track_observations: Some(preset.min_track_observations()),
+            min_track_length_ratio: Some(preset.min_track_length_ratio()),
             biconnected: Some(false),
             order: Order::default(),
             image_path: None,
@@ -92,6 +97,7 @@ impl Parameters {
             min_num_matches: self.min_num_matches,
             rule: self.rule(),
             min_track_observations: self.min_track_observations.unwrap_or(0),
+            min_track_length_ratio: self.min_track_length_ratio.unwrap_or(0.0),
             biconnected: self.biconnected.unwrap_or(false),
             model: self.cost_model.clone(),
             unweighted_priors,

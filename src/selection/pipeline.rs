@@ -17,7 +17,7 @@ use crate::selection::capture_order::{self, CaptureOrder};
 use crate::selection::overrides::{Listed, Overrides};
 use crate::selection::parameters::Parameters;
 use crate::selection::preset::Preset;
-use crate::selection::track_observations::TrackObservations;
+use crate::selection::track_completion::{self, Completion, Needs};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -32,9 +32,12 @@ pub struct Options {
     pub min_num_matches: usize,
     /// How the flow F is chosen: fixed, or searched against the image and pair criteria.
     pub rule: FlowRule,
-    /// A criteria search also keeps this many keypoints of every image on feature tracks of
-    /// three or more observations ([`TrackObservations`]); 0: off.
+    /// After a criteria search, pairs are added until every image keeps this many keypoints on
+    /// feature tracks of three or more observations ([`track_completion`]); 0: off.
     pub min_track_observations: usize,
+    /// ... and until the mean track length a keypoint sees is this share of the full graph's;
+    /// 0: off.
+    pub min_track_length_ratio: f64,
     /// A criteria search also keeps the selection free of cut images ([`Biconnected`]).
     pub biconnected: bool,
     /// The priors, their g and weights, and the fitness floor that make the arc costs.
@@ -87,7 +90,10 @@ pub struct Plan {
     /// The order the pair arcs followed.
     pub order: CaptureOrder,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
+    /// Its selection includes the pairs the track completion added.
     pub search: SearchResult,
+    /// What the track completion added to the flow's selection (None when it did not run).
+    pub completion: Option<Completion>,
     /// The fitness floor applied (see [`fitness_floor`]).
     pub fitness_floor: f64,
     /// Free edges (neither kept nor forbidden) below `fitness_floor`, taken out of the network.
@@ -192,14 +198,9 @@ pub fn plan_with(
     );
     let searched = matches!(options.rule, FlowRule::Criteria(_));
     let biconnected = (searched && options.biconnected).then(|| Biconnected::new(&network.problem));
-    let tracks = (searched && options.min_track_observations > 0)
-        .then(|| TrackObservations::new(&scene, &network, options.min_track_observations));
     let mut checks: Vec<&dyn SelectionCheck> = Vec::new();
     if let Some(b) = &biconnected {
         checks.push(b);
-    }
-    if let Some(t) = &tracks {
-        checks.push(t);
     }
     let mut search = search::search_with_curve(
         &network.problem,
@@ -209,6 +210,29 @@ pub fn plan_with(
     );
     search.selection = network.expand(&search.selection);
     search.selection.images = order.by_vertex(&search.selection.images);
+    let needs = Needs {
+        min_track_observations: options.min_track_observations,
+        min_track_length_ratio: options.min_track_length_ratio,
+    };
+    // A capped search kept everything already.
+    let completion = (searched
+        && !search.capped
+        && (needs.min_track_observations > 0 || needs.min_track_length_ratio > 0.0))
+        .then(|| {
+            stage("completing feature tracks");
+            let done =
+                track_completion::complete(&scene, &network, &mut search.selection.pairs, &needs);
+            for (e, _) in graph
+                .edges
+                .iter()
+                .zip(&search.selection.pairs)
+                .filter(|(_, &k)| k)
+            {
+                search.selection.images[e.i as usize] = true;
+                search.selection.images[e.j as usize] = true;
+            }
+            done
+        });
     timings.solve = t.elapsed().as_secs_f64();
 
     let invalidate = graph
@@ -231,6 +255,7 @@ pub fn plan_with(
         overrides: resolved.listed,
         order,
         search,
+        completion,
         fitness_floor: floor,
         below_fitness_floor,
         invalidate,
@@ -436,6 +461,7 @@ mod tests {
             curve_factor: 0,
             capture: Default::default(),
             min_track_observations: 0,
+            min_track_length_ratio: 0.0,
             biconnected: false,
         };
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor

@@ -48,8 +48,8 @@ impl Preset {
         }
     }
 
-    /// The flow search's track criterion (keypoints each image keeps on tracks of three or more
-    /// observations, [`crate::selection::track_observations`]); 0: off.
+    /// The track completion's keypoints each image keeps on tracks of three or more
+    /// observations ([`crate::selection::track_completion`]); 0: off.
     pub fn min_track_observations(self) -> usize {
         match self {
             // COLMAP's mapper wants 100 inliers to start a model (init_min_num_inliers); chosen
@@ -57,6 +57,14 @@ impl Preset {
             // (docs/performance.md).
             Preset::General => 100,
             Preset::Disambiguation | Preset::PaperDisambiguation => 0,
+        }
+    }
+
+    /// The track completion's share of the full graph's mean track length; 0: off.
+    pub fn min_track_length_ratio(self) -> f64 {
+        match self {
+            Preset::General => 0.7,
+            Preset::Disambiguation | Preset::PaperDisambiguation => 0.0,
         }
     }
 
