@@ -106,6 +106,8 @@ fn every_image_keeps_its_long_track_keypoints() {
             n.to_string(),
             "--min_track_length_ratio".into(),
             "0".into(),
+            "--spanning_tree".into(),
+            "false".into(),
         ]
     };
     fn args(v: &[String]) -> Vec<&str> {
@@ -121,8 +123,16 @@ fn every_image_keeps_its_long_track_keypoints() {
         assert_eq!(short_of(&kept, n), 0, "N = {n}");
         let c = &report["completion"];
         assert!(c["images_short"].as_u64().unwrap() > 0, "{c}");
+        let added: u64 = [
+            "pairs_added_for_spanning_tree",
+            "pairs_added_for_images",
+            "pairs_added_for_track_length",
+        ]
+        .iter()
+        .map(|k| c[k].as_u64().unwrap())
+        .sum();
         assert_eq!(
-            c["pairs_from_flow"].as_u64().unwrap() + c["pairs_added_for_images"].as_u64().unwrap(),
+            c["pairs_from_flow"].as_u64().unwrap() + added,
             report["pairs_selected"].as_u64().unwrap()
         );
         assert_eq!(report["capped"], false);
@@ -155,6 +165,8 @@ fn the_track_length_reaches_its_share_of_the_full_graphs() {
             "0",
             "--min_track_length_ratio",
             ratio,
+            "--spanning_tree",
+            "false",
             "-q",
         ]);
         let report: serde_json::Value =

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Feature tracks of COLMAP databases, as the mapper would build them from the valid pairs: the
 mean track length a keypoint sees, and each image's keypoints on tracks of three or more
-observations (what `--min_track_observations` counts), the fewest first.
+observations (what the track completion's `--min_track_observations` counts; its
+`--min_track_length_ratio` compares the mean track length), the fewest first.
 
 usage: track-lengths.py FULL.db [PRUNED.db ...]   (read only; pairs with >= 15 inliers, config > 1)
 For each pruned database the worst images are also given as a share of their count in FULL.db.

@@ -3,7 +3,7 @@
 //! more). A chain or a tree of pairs meets coverage criteria as well as a ring does, but each of
 //! its images is a single point of failure for the mapper; the authors' later code asked for
 //! k-connectivity in the same place. Measured, it did not pay (docs/performance.md): on a
-//! rendered 100-image orbit the chain of 99 pairs that the track criterion keeps gave a model
+//! rendered 100-image orbit the chain of 99 pairs that a registrability criterion kept gave a model
 //! 1.5x less accurate than the full one, and the biconnected selection (197 pairs) 4x, so no
 //! preset turns it on.
 

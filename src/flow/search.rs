@@ -8,7 +8,7 @@
 //! selected >= min(max(ceil(B n), ceil(P |E|)), |E|).
 //!
 //! A caller may add [`SelectionCheck`]s computed from the selected pairs
-//! ([`crate::connectivity::Biconnected`], the main crate's track criterion); they are evaluated
+//! ([`crate::connectivity::Biconnected`]); they are evaluated
 //! once the other targets hold, in steps (see the trait).
 //!
 //! When no F meets both targets the full graph is kept (`capped`): every image and every pair

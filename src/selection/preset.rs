@@ -11,9 +11,10 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "lowercase")]
 pub enum Preset {
     /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
-    /// angle, overlap, infinite homography. Search: 90% of images, and every image keeps 100
-    /// keypoints on tracks of three or more images (half of its own, if fewer): as many pairs as each
-    /// image needs to stay registrable, which adapts to how densely the images overlap.
+    /// angle, overlap, infinite homography. Search: 90% of images; then the track completion adds
+    /// pairs until every image keeps 100 keypoints on tracks of three or more images (half of its
+    /// own, if fewer) and the tracks keep 0.7 of the full graph's mean length: as many pairs as
+    /// the images need to stay registrable and accurate, which adapts to how densely they overlap.
     General,
     /// For scenes with duplicate or symmetric structure, whatever the image order: pair prior
     /// backbone tracks (the share of a pair's inliers that tracks through each image's strongest
@@ -53,16 +54,24 @@ impl Preset {
     pub fn min_track_observations(self) -> usize {
         match self {
             // COLMAP's mapper wants 100 inliers to start a model (init_min_num_inliers); chosen
-            // on castle and Herz-Jesus, judged on templeRing, lego and rendered scenes
-            // (docs/performance.md).
+            // on castle and Herz-Jesus (docs/performance.md).
             Preset::General => 100,
             Preset::Disambiguation | Preset::PaperDisambiguation => 0,
         }
     }
 
+    /// Whether the track completion keeps the maximum spanning forest by inliers: not where
+    /// strong pairs may be false ones (the disambiguation presets).
+    pub fn spanning_tree(self) -> bool {
+        self == Preset::General
+    }
+
     /// The track completion's share of the full graph's mean track length; 0: off.
     pub fn min_track_length_ratio(self) -> f64 {
         match self {
+            // Chosen on castle, Herz-Jesus and the rendered room100: 0.6 left room100's
+            // positions 1.5x less accurate, 0.7 as accurate as the full graph
+            // (docs/performance.md).
             Preset::General => 0.7,
             Preset::Disambiguation | Preset::PaperDisambiguation => 0.0,
         }
