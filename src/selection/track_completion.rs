@@ -278,6 +278,7 @@ pub fn complete(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::colmap::database::VerifiedPair;
     use crate::flow::network::{ArcRule, PairArc, SelectionProblem};
     use crate::priors::tracks::Tracks;
     use crate::scene::testing::{images, pair};
@@ -321,6 +322,44 @@ mod tests {
             .count()
     }
 
+    /// Images 1..=n of `kps` keypoints each and `pairs`: `setup(m)` gives each of the m
+    /// view-graph edges its network rule and whether the flow kept it; the completion of
+    /// `needs` runs, and `check(scene, rules, start, kept, done)` judges it.
+    fn run(
+        n: u32,
+        pairs: &[VerifiedPair],
+        kps: usize,
+        needs: Needs,
+        setup: impl FnOnce(usize) -> (Vec<ArcRule>, Vec<bool>),
+        check: impl FnOnce(&Scene, &[ArcRule], &[bool], &[bool], Completion),
+    ) {
+        let imgs = images(n);
+        let graph = ViewGraph::build(&imgs, pairs, 1);
+        let scene = Scene::new(
+            &graph,
+            pairs,
+            vec![vec![[0.0, 0.0]; kps]; n as usize],
+            vec![(100, 100); n as usize],
+        );
+        let problem = SelectionProblem {
+            image_costs: vec![-0.5; n as usize],
+            pairs: graph
+                .edges
+                .iter()
+                .map(|e| PairArc {
+                    i: e.i,
+                    j: e.j,
+                    cost: -0.5,
+                })
+                .collect(),
+        };
+        let (rules, start) = setup(graph.edges.len());
+        let restriction = problem.restrict(&vec![false; n as usize], &rules);
+        let mut kept = start.clone();
+        let done = complete(&scene, &restriction, &mut kept, &needs);
+        check(&scene, &rules, &start, &kept, done);
+    }
+
     #[test]
     fn the_lazy_greedy_adds_what_a_plain_greedy_adds() {
         let mut rng = Lcg(7);
@@ -340,80 +379,62 @@ mod tests {
                     pairs.push(pair(a, b, inliers));
                 }
             }
-            let imgs = images(n);
-            let graph = ViewGraph::build(&imgs, &pairs, 1);
-            if graph.edges.is_empty() {
-                continue;
-            }
-            let scene = Scene::new(
-                &graph,
-                &pairs,
-                vec![vec![[0.0, 0.0]; kps]; n as usize],
-                vec![(100, 100); n as usize],
-            );
-            let m = graph.edges.len();
-            let problem = SelectionProblem {
-                image_costs: vec![-0.5; n as usize],
-                pairs: graph
-                    .edges
-                    .iter()
-                    .map(|e| PairArc {
-                        i: e.i,
-                        j: e.j,
-                        cost: -0.5,
-                    })
-                    .collect(),
-            };
-            // Some pairs leave the network, as below the fitness floor.
-            let rules: Vec<ArcRule> = (0..m)
-                .map(|_| {
-                    if rng.below(5) == 0 {
-                        ArcRule::Removed
-                    } else {
-                        ArcRule::Free
-                    }
-                })
-                .collect();
-            let restriction = problem.restrict(&vec![false; n as usize], &rules);
-            let start: Vec<bool> = (0..m)
-                .map(|e| rules[e] == ArcRule::Free && rng.below(4) == 0)
-                .collect();
             let ratio = [0.3, 0.6, 0.9, 1.0][round % 4];
             let needs = Needs {
                 spanning_tree: false,
                 min_track_observations: 0,
                 min_track_length_ratio: ratio,
             };
-            let mut kept = start.clone();
-            let done = complete(&scene, &restriction, &mut kept, &needs);
-
-            // The plain greedy: recompute every gain, take the best (ties to the higher index).
-            let selectable: Vec<bool> = rules.iter().map(|r| *r == ArcRule::Free).collect();
-            let full: Vec<bool> = (0..m).map(|e| selectable[e] || start[e]).collect();
-            let target = ratio * mean_length(&scene, &full);
-            let mut plain = start.clone();
-            while mean_length(&scene, &plain) < target {
-                let best = (0..m)
-                    .filter(|&e| selectable[e] && !plain[e])
-                    .map(|e| (joins(&scene, &plain, e), e))
-                    .max();
-                let Some((_, e)) = best else { break };
-                plain[e] = true;
-            }
-            assert_eq!(kept, plain, "round {round}");
-            assert!((done.track_length - mean_length(&scene, &kept)).abs() < 1e-9);
-            assert!((done.track_length_full - mean_length(&scene, &full)).abs() < 1e-9);
-            assert!(
-                done.track_length >= target - 1e-9,
-                "round {round}: target missed"
+            // Some pairs leave the network, as below the fitness floor.
+            let setup = |m: usize| {
+                let rules: Vec<ArcRule> = (0..m)
+                    .map(|_| match rng.below(5) {
+                        0 => ArcRule::Removed,
+                        _ => ArcRule::Free,
+                    })
+                    .collect();
+                let start = (0..m)
+                    .map(|e| rules[e] == ArcRule::Free && rng.below(4) == 0)
+                    .collect();
+                (rules, start)
+            };
+            run(
+                n,
+                &pairs,
+                kps,
+                needs,
+                setup,
+                |scene, rules, start, kept, done| {
+                    // The plain greedy: recompute every gain, take the best (ties to the higher index).
+                    let m = rules.len();
+                    let selectable: Vec<bool> = rules.iter().map(|r| *r == ArcRule::Free).collect();
+                    let full: Vec<bool> = (0..m).map(|e| selectable[e] || start[e]).collect();
+                    let target = ratio * mean_length(scene, &full);
+                    let mut plain = start.to_vec();
+                    while mean_length(scene, &plain) < target {
+                        let best = (0..m)
+                            .filter(|&e| selectable[e] && !plain[e])
+                            .map(|e| (joins(scene, &plain, e), e))
+                            .max();
+                        let Some((_, e)) = best else { break };
+                        plain[e] = true;
+                    }
+                    assert_eq!(kept, plain, "round {round}");
+                    assert!((done.track_length - mean_length(scene, &kept)).abs() < 1e-9);
+                    assert!((done.track_length_full - mean_length(scene, &full)).abs() < 1e-9);
+                    assert!(
+                        done.track_length >= target - 1e-9,
+                        "round {round}: target missed"
+                    );
+                    let added = kept.iter().zip(start).filter(|(k, s)| **k && !**s).count();
+                    assert_eq!(done.pairs_added_for_track_length, added);
+                    assert!(kept
+                        .iter()
+                        .zip(&selectable)
+                        .zip(start)
+                        .all(|((k, s), b)| !k || *s || *b));
+                },
             );
-            let added = kept.iter().zip(&start).filter(|(k, s)| **k && !**s).count();
-            assert_eq!(done.pairs_added_for_track_length, added);
-            assert!(kept
-                .iter()
-                .zip(&selectable)
-                .zip(&start)
-                .all(|((k, s), b)| !k || *s || *b));
         }
     }
 
@@ -434,65 +455,47 @@ mod tests {
                     }
                 }
             }
-            let imgs = images(n);
-            let graph = ViewGraph::build(&imgs, &pairs, 1);
-            let m = graph.edges.len();
-            let scene = Scene::new(
-                &graph,
-                &pairs,
-                vec![vec![[0.0, 0.0]; 9]; n as usize],
-                vec![(100, 100); n as usize],
-            );
-            let problem = SelectionProblem {
-                image_costs: vec![-0.5; n as usize],
-                pairs: graph
-                    .edges
-                    .iter()
-                    .map(|e| PairArc {
-                        i: e.i,
-                        j: e.j,
-                        cost: -0.5,
-                    })
-                    .collect(),
-            };
-            let restriction = problem.restrict(&vec![false; n as usize], &vec![ArcRule::Free; m]);
-            let mut kept: Vec<bool> = (0..m).map(|_| rng.below(5) == 0).collect();
-            let start = kept.clone();
             let needs = Needs {
                 spanning_tree: true,
                 min_track_observations: 0,
                 min_track_length_ratio: 0.0,
             };
-            let done = complete(&scene, &restriction, &mut kept, &needs);
-            let weight = |e: usize| scene.edge_inliers(e).count();
-            let connected = |a: u32, b: u32, w: usize| {
-                let mut seen = vec![false; n as usize];
-                let mut stack = vec![a];
-                seen[a as usize] = true;
-                while let Some(v) = stack.pop() {
-                    for (k, e) in graph.edges.iter().enumerate() {
-                        if !kept[k] || weight(k) < w || (e.i != v && e.j != v) {
-                            continue;
-                        }
-                        let u = if e.i == v { e.j } else { e.i };
-                        if !seen[u as usize] {
-                            seen[u as usize] = true;
-                            stack.push(u);
+            let setup = |m: usize| {
+                let start = (0..m).map(|_| rng.below(5) == 0).collect();
+                (vec![ArcRule::Free; m], start)
+            };
+            run(n, &pairs, 9, needs, setup, |scene, _, start, kept, done| {
+                let edges = &scene.graph.edges;
+                let weight = |e: usize| scene.edge_inliers(e).count();
+                let connected = |a: u32, b: u32, w: usize| {
+                    let mut seen = vec![false; n as usize];
+                    let mut stack = vec![a];
+                    seen[a as usize] = true;
+                    while let Some(v) = stack.pop() {
+                        for (k, e) in edges.iter().enumerate() {
+                            if !kept[k] || weight(k) < w || (e.i != v && e.j != v) {
+                                continue;
+                            }
+                            let u = if e.i == v { e.j } else { e.i };
+                            if !seen[u as usize] {
+                                seen[u as usize] = true;
+                                stack.push(u);
+                            }
                         }
                     }
+                    seen[b as usize]
+                };
+                for (k, e) in edges.iter().enumerate().filter(|(k, _)| !kept[*k]) {
+                    assert!(
+                        connected(e.i, e.j, weight(k)),
+                        "round {round}: pair {k} ({e:?})"
+                    );
                 }
-                seen[b as usize]
-            };
-            for (k, e) in graph.edges.iter().enumerate().filter(|(k, _)| !kept[*k]) {
-                assert!(
-                    connected(e.i, e.j, weight(k)),
-                    "round {round}: pair {k} ({e:?})"
-                );
-            }
-            // No more than a forest's worth was added.
-            let added = kept.iter().zip(&start).filter(|(k, s)| **k && !**s).count();
-            assert_eq!(done.pairs_added_for_spanning_tree, added);
-            assert!(added < n as usize, "round {round}");
+                // No more than a forest's worth was added.
+                let added = kept.iter().zip(start).filter(|(k, s)| **k && !**s).count();
+                assert_eq!(done.pairs_added_for_spanning_tree, added);
+                assert!(added < n as usize, "round {round}");
+            });
         }
     }
 
@@ -508,50 +511,31 @@ mod tests {
                 pairs.push(pair(a, b, inliers));
             }
         }
-        let imgs = images(n);
-        let graph = ViewGraph::build(&imgs, &pairs, 1);
-        let scene = Scene::new(
-            &graph,
-            &pairs,
-            vec![vec![[0.0, 0.0]; 6]; n as usize],
-            vec![(100, 100); n as usize],
-        );
-        let m = graph.edges.len();
-        let problem = SelectionProblem {
-            image_costs: vec![-0.5; n as usize],
-            pairs: graph
-                .edges
-                .iter()
-                .map(|e| PairArc {
-                    i: e.i,
-                    j: e.j,
-                    cost: -0.5,
-                })
-                .collect(),
-        };
-        let restriction = problem.restrict(&vec![false; n as usize], &vec![ArcRule::Free; m]);
         for need in [1, 3, 6] {
-            // One pair kept: its two images see tracks of two only.
-            let mut kept = vec![false; m];
-            kept[0] = true;
             let needs = Needs {
                 spanning_tree: false,
                 min_track_observations: need,
                 min_track_length_ratio: 0.0,
             };
-            let done = complete(&scene, &restriction, &mut kept, &needs);
-            let t = Tracks::build(&scene, |e| kept[e]);
-            for v in 0..n {
-                // The full graph gives each image 6 such keypoints: the need is min(need, 3).
-                assert!(
-                    t.observations_on_tracks(v, MIN_TRACK_LENGTH) >= need.min(3),
-                    "{v}"
-                );
-            }
-            assert!(done.images_short >= 1);
-            // Tracks of three for all five images need at least four pairs: three more.
-            assert!(done.pairs_added_for_images >= 3);
-            assert_eq!(done.pairs_added_for_track_length, 0);
+            let setup = |m: usize| {
+                let mut start = vec![false; m];
+                start[0] = true;
+                (vec![ArcRule::Free; m], start)
+            };
+            run(n, &pairs, 6, needs, setup, |scene, _, _, kept, done| {
+                let t = Tracks::build(scene, |e| kept[e]);
+                for v in 0..n {
+                    // The full graph gives each image 6 such keypoints: the need is min(need, 3).
+                    assert!(
+                        t.observations_on_tracks(v, MIN_TRACK_LENGTH) >= need.min(3),
+                        "{v}"
+                    );
+                }
+                assert!(done.images_short >= 1);
+                // Tracks of three for all five images need at least four pairs: three more.
+                assert!(done.pairs_added_for_images >= 3);
+                assert_eq!(done.pairs_added_for_track_length, 0);
+            });
         }
     }
 }
