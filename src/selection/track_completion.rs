@@ -420,7 +420,7 @@ mod tests {
                         plain[e] = true;
                     }
                     assert_eq!(kept, plain, "round {round}");
-                    assert!((done.track_length - mean_length(scene, &kept)).abs() < 1e-9);
+                    assert!((done.track_length - mean_length(scene, kept)).abs() < 1e-9);
                     assert!((done.track_length_full - mean_length(scene, &full)).abs() < 1e-9);
                     assert!(
                         done.track_length >= target - 1e-9,
