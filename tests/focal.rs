@@ -29,7 +29,7 @@ fn guessed_focal_length_is_replaced_by_the_estimate() {
         capture: Default::default(),
         min_track_observations: 0,
         min_track_length_ratio: 0.0,
-        spanning_tree: false,
+        spanning_forests: 0,
         biconnected: false,
     };
     let p = plan(&db, &options, &|_| {}).unwrap();

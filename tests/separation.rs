@@ -43,7 +43,7 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
         capture: Default::default(),
         min_track_observations: 0,
         min_track_length_ratio: 0.0,
-        spanning_tree: false,
+        spanning_forests: 0,
         biconnected: false,
     };
     let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();

@@ -31,7 +31,7 @@ impl DatabaseArg {
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
     /// Use this total flow F instead of searching for it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations", "min_track_length_ratio", "spanning_tree", "biconnected"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations", "min_track_length_ratio", "spanning_forests", "biconnected"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images
     /// [default: 0.9, disambiguation preset 0.8].
@@ -58,11 +58,11 @@ pub struct FlowArgs {
     /// view graph's, which the cameras' accuracy depends on [default: 0.7, other presets 0 (off)].
     #[arg(long, value_parser = fraction)]
     min_track_length_ratio: Option<f64>,
-    /// After the search, the strongest pairs that connect the view graph (its maximum spanning
-    /// forest by inliers) are added first, so that no part of the scene hangs on a weak pair
-    /// [default: true, other presets false].
+    /// After the search, first add this many maximum spanning forests of the view graph by
+    /// inliers (each of the pairs the ones before left), so that no part of the scene hangs on
+    /// weak pairs [default: 3, other presets 0].
     #[arg(long)]
-    spanning_tree: Option<bool>,
+    spanning_forests: Option<usize>,
     /// Search: ... and no image cuts the selection apart: it stays connected without any one
     /// image [default: false].
     #[arg(long)]
@@ -99,12 +99,12 @@ impl FlowArgs {
             .then(|| self.min_track_length_ratio.unwrap_or(default))
     }
 
-    /// The track completion's spanning forest: None with a fixed flow, else as given or
+    /// The track completion's spanning forests: None with a fixed flow, else as given or
     /// `default`.
-    pub fn spanning_tree(&self, default: bool) -> Option<bool> {
+    pub fn spanning_forests(&self, default: usize) -> Option<usize> {
         self.flow
             .is_none()
-            .then(|| self.spanning_tree.unwrap_or(default))
+            .then(|| self.spanning_forests.unwrap_or(default))
     }
 
     /// The connectivity criterion: None with a fixed flow, else as given; off by default in

@@ -147,7 +147,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         min_track_length_ratio: args
             .flow
             .track_length_ratio(args.preset.min_track_length_ratio()),
-        spanning_tree: args.flow.spanning_tree(args.preset.spanning_tree()),
+        spanning_forests: args.flow.spanning_forests(args.preset.spanning_forests()),
         biconnected: args.flow.biconnected(),
         order: args.order,
         image_path: path_text(&args.image_path),

@@ -241,10 +241,10 @@ impl Report {
         if let Some(c) = &self.completion {
             s += &format!(
                 "track completion: the flow kept {} pairs; {} added from the strongest spanning \
-                 tree, {} for {} images short of keypoints on tracks, {} for the track length \
+                 forests, {} for {} images short of keypoints on tracks, {} for the track length \
                  ({:.1} -> {:.1}; full graph {:.1})\n",
                 c.pairs_from_flow,
-                c.pairs_added_for_spanning_tree,
+                c.pairs_added_for_spanning_forests,
                 c.pairs_added_for_images,
                 c.images_short,
                 c.pairs_added_for_track_length,

@@ -38,10 +38,10 @@ pub struct Parameters {
     /// flow or in older records: off).
     #[serde(default)]
     pub min_track_length_ratio: Option<f64>,
-    /// The track completion keeps the maximum spanning forest by inliers (None with a fixed flow
-    /// or in older records: off).
+    /// Maximum spanning forests by inliers the track completion keeps (None with a fixed flow
+    /// or in older records: none).
     #[serde(default)]
-    pub spanning_tree: Option<bool>,
+    pub spanning_forests: Option<usize>,
     /// The search's connectivity criterion: no cut image in the selection (None with a fixed
     /// flow or in older records: off).
     #[serde(default)]
@@ -75,7 +75,7 @@ impl Parameters {
             min_pairs_each: Some(c.min_pairs_each),
             min_track_observations: Some(preset.min_track_observations()),
             min_track_length_ratio: Some(preset.min_track_length_ratio()),
-            spanning_tree: Some(preset.spanning_tree()),
+            spanning_forests: Some(preset.spanning_forests()),
             biconnected: Some(false),
             order: Order::default(),
             image_path: None,
@@ -103,7 +103,7 @@ impl Parameters {
             rule: self.rule(),
             min_track_observations: self.min_track_observations.unwrap_or(0),
             min_track_length_ratio: self.min_track_length_ratio.unwrap_or(0.0),
-            spanning_tree: self.spanning_tree.unwrap_or(false),
+            spanning_forests: self.spanning_forests.unwrap_or(0),
             biconnected: self.biconnected.unwrap_or(false),
             model: self.cost_model.clone(),
             unweighted_priors,

@@ -35,8 +35,8 @@ pub struct Options {
     /// After a criteria search, pairs are added until every image keeps this many keypoints on
     /// feature tracks of three or more observations ([`track_completion`]); 0: off.
     pub min_track_observations: usize,
-    /// ... after adding the maximum spanning forest by inliers, when set ...
-    pub spanning_tree: bool,
+    /// ... after adding this many maximum spanning forests by inliers ...
+    pub spanning_forests: usize,
     /// ... and until the mean track length a keypoint sees is this share of the full graph's;
     /// 0: off.
     pub min_track_length_ratio: f64,
@@ -213,14 +213,14 @@ pub fn plan_with(
     search.selection = network.expand(&search.selection);
     search.selection.images = order.by_vertex(&search.selection.images);
     let needs = Needs {
-        spanning_tree: options.spanning_tree,
+        spanning_forests: options.spanning_forests,
         min_track_observations: options.min_track_observations,
         min_track_length_ratio: options.min_track_length_ratio,
     };
     // A capped search kept everything already.
     let completion = (searched
         && !search.capped
-        && (needs.spanning_tree
+        && (needs.spanning_forests > 0
             || needs.min_track_observations > 0
             || needs.min_track_length_ratio > 0.0))
         .then(|| {
@@ -467,7 +467,7 @@ mod tests {
             capture: Default::default(),
             min_track_observations: 0,
             min_track_length_ratio: 0.0,
-            spanning_tree: false,
+            spanning_forests: 0,
             biconnected: false,
         };
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor

@@ -60,10 +60,15 @@ impl Preset {
         }
     }
 
-    /// Whether the track completion keeps the maximum spanning forest by inliers: not where
-    /// strong pairs may be false ones (the disambiguation presets).
-    pub fn spanning_tree(self) -> bool {
-        self == Preset::General
+    /// Maximum spanning forests by inliers the track completion keeps: none where strong pairs
+    /// may be false ones (the disambiguation presets).
+    pub fn spanning_forests(self) -> usize {
+        match self {
+            // Chosen on templeRing with COLMAP 4.2's global mapper (one or two forests: 24
+            // cameras correct, three: 31 as on the full graph; docs/performance.md).
+            Preset::General => 3,
+            Preset::Disambiguation | Preset::PaperDisambiguation => 0,
+        }
     }
 
     /// The track completion's share of the full graph's mean track length; 0: off.
