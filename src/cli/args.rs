@@ -85,7 +85,7 @@ impl FlowArgs {
         }
     }
 
-    /// The track criterion: None with a fixed flow, else as given or `default`.
+    /// The track completion's keypoint need: None with a fixed flow, else as given or `default`.
     pub fn track_observations(&self, default: usize) -> Option<usize> {
         self.flow
             .is_none()
