@@ -216,7 +216,8 @@ pub fn complete(
         // the earlier forests left; the forced pairs count as candidates too, so a weak forced
         // pair does not hide a strong one across the same cut.
         let mut order: Vec<usize> = (0..edges).filter(|&e| selectable[e] || kept[e]).collect();
-        order.sort_by_key(|&e| (Reverse(scene.edge_inliers(e).count()), e));
+        // Counting an edge's inliers walks them: once per edge, not once per comparison.
+        order.sort_by_cached_key(|&e| (Reverse(scene.edge_inliers(e).count()), e));
         let mut in_forest = vec![false; edges];
         for _ in 0..needs.spanning_forests {
             let mut forest = UnionFind::<u32>::new(scene.graph.num_vertices());
