@@ -218,26 +218,21 @@ pub fn plan_with(
         min_track_length_ratio: options.min_track_length_ratio,
     };
     // A capped search kept everything already.
-    let completion = (searched
-        && !search.capped
-        && (needs.spanning_forests > 0
-            || needs.min_track_observations > 0
-            || needs.min_track_length_ratio > 0.0))
-        .then(|| {
-            stage("completing feature tracks");
-            let done =
-                track_completion::complete(&scene, &network, &mut search.selection.pairs, &needs);
-            for (e, _) in graph
-                .edges
-                .iter()
-                .zip(&search.selection.pairs)
-                .filter(|(_, &k)| k)
-            {
-                search.selection.images[e.i as usize] = true;
-                search.selection.images[e.j as usize] = true;
-            }
-            done
-        });
+    let completion = (searched && !search.capped && needs.any()).then(|| {
+        stage("completing feature tracks");
+        let done =
+            track_completion::complete(&scene, &network, &mut search.selection.pairs, &needs);
+        for (e, _) in graph
+            .edges
+            .iter()
+            .zip(&search.selection.pairs)
+            .filter(|(_, &k)| k)
+        {
+            search.selection.images[e.i as usize] = true;
+            search.selection.images[e.j as usize] = true;
+        }
+        done
+    });
     timings.solve = t.elapsed().as_secs_f64();
 
     let invalidate = graph

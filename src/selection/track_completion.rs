@@ -1,7 +1,7 @@
 //! Track completion: after the flow, add the pairs that the mapper's feature tracks need. Three
 //! needs, in this order:
 //!
-//! 0. No weak bridge: K maximum spanning forests of the view graph by inliers, each of the pairs
+//! 1. No weak bridge: K maximum spanning forests of the view graph by inliers, each of the pairs
 //!    the ones before left, so that every split of the images in two keeps its K strongest pairs
 //!    across it where the full graph has them (the union is Nagamochi and Ibaraki's sparse
 //!    certificate of K-edge-connectivity). The flow follows the pair arcs' order and crosses from
@@ -10,22 +10,23 @@
 //!    COLMAP 3.8 mapper split the scene in two models (24 and 14 of 47 images). One forest mended
 //!    that; COLMAP 4.2's global mapper still placed 7 more cameras wrongly than on the full
 //!    graph with one or two forests, and as many as the full graph with three.
-//! 1. Registrability: every image keeps N keypoints on tracks of three or more observations, or
+//! 2. Registrability: every image keeps N keypoints on tracks of three or more observations, or
 //!    half of those it has on such tracks through the selectable pairs (all, less those forbidden
 //!    or below the fitness floor) if that is fewer. The mapper registers an image from 2D-3D
 //!    matches, and a point exists only once two other images observe it, so only a keypoint
 //!    whose track reaches two more images can help; on Herz-Jesus 3 pairs per image left two
 //!    images with none and the mapper dropped exactly those two (docs/performance.md).
-//! 2. Redundancy: the mean track length a keypoint sees (sum of s² / sum of s over tracks of s >= 2
-//!    observations) reaches a share of the full graph's. A sparse selection splits tracks: on the
-//!    rendered room100 the flow's chain kept 42% of it and its cameras were 1.5x less accurate;
-//!    at 60%, restored by this greedy with 259 pairs, 1.14x.
+//! 3. Redundancy: the mean track length a keypoint sees (sum of s² / sum of s over tracks of
+//!    s >= 2 observations) reaches a share of the full graph's. A sparse selection splits
+//!    tracks: on the rendered room100 the flow's chain kept 42% of it and its cameras' positions
+//!    were 1.5x less accurate; 60% (224 pairs) left 1.48x, 70% (418 pairs) 0.98x.
 //!
-//! Needs 1 and 2 are met greedily, by how many tracks each pair joins. Why greedy on joined tracks: the flow's cheap pairs run along the capture (neighbours'
-//! pairs); more flow adds parallel chains that rarely merge tracks (room100: 390 pairs from the
-//! flow reached 54% of the track length, 259 from this greedy 60%). A pair's gain is the number
-//! of its inliers whose keypoints lie on different tracks; gains only fall as tracks merge, so
-//! a lazy max-heap finds the best pair exactly.
+//! Needs 2 and 3 are met greedily, by how many tracks each pair joins. Why greedy on joined
+//! tracks: the flow's cheap pairs run along the capture (neighbours' pairs); more flow adds
+//! parallel chains that rarely merge tracks (room100: 390 pairs from the flow reached 54% of the
+//! track length, 224 from this greedy 60%). A pair's gain is the number of its inliers whose
+//! keypoints lie on different tracks; gains only fall as tracks merge, so a lazy max-heap finds
+//! the best pair exactly.
 //!
 //! Completing after the flow rather than searching F for these needs lets the flow stop where
 //! its own criteria hold: on lego, four weakly linked images were served by the flow only at
@@ -50,6 +51,15 @@ pub struct Needs {
     pub min_track_observations: usize,
     /// Share of the full graph's mean track length the selection keeps (0: off).
     pub min_track_length_ratio: f64,
+}
+
+impl Needs {
+    /// Whether any need is on.
+    pub fn any(&self) -> bool {
+        self.spanning_forests > 0
+            || self.min_track_observations > 0
+            || self.min_track_length_ratio > 0.0
+    }
 }
 
 /// What a completion did, for the report.
