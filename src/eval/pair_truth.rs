@@ -1,7 +1,12 @@
 //! Labelling a database's verified pairs true or false from ground-truth poses: a pair is true
 //! when the median Sampson distance of its inliers under the ground-truth epipolar geometry is
-//! below a few pixels. A false pair (matches between two copies of a duplicated object) is
-//! consistent with some two-view geometry, but not with the true one.
+//! below a few pixels, where an inlier whose rays meet behind a camera or beyond the scene counts
+//! as infinitely far off. A false pair (matches between two copies of a duplicated object) is
+//! consistent with some two-view geometry, but not with the true one. The epipolar distance alone
+//! misses one case: two copies seen from the same place relative to each, by cameras that differ
+//! by a translation only. Their matches sit at the same pixels, and x·(t × x) = 0 puts every such
+//! match exactly on its epipolar line; but the rays are parallel, 14 m apart in the rendered twin
+//! scene, and meet nowhere in front of the cameras.
 //!
 //! Why: the mapper's model only shows the end result; counting the false pairs a prune removed
 //! and the true pairs it kept says whether the selection itself did the right thing.
@@ -11,8 +16,9 @@ use crate::colmap::ids::image_ids;
 use crate::colmap::ids::{camera_model_id, camera_model_num_params};
 use crate::colmap::model;
 use crate::geometry::camera::CameraModel;
-use crate::geometry::pose::sampson_distance;
+use crate::geometry::pose::{sampson_distance, triangulate};
 use anyhow::{ensure, Context, Result};
+use nalgebra::{Rotation3, Vector3};
 use petgraph::unionfind::UnionFind;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
@@ -20,6 +26,12 @@ use std::path::Path;
 
 /// A pair is true when the median Sampson distance of its inliers is below this many pixels.
 pub const SAMPSON_THRESHOLD_PX: f64 = 4.0;
+
+/// An inlier's rays must meet within this many times the extent of the ground truth's camera
+/// centres (the diagonal of their bounding box): every surface of the rendered scenes, and of
+/// the photographed ones, lies well within it, and rays that are parallel up to noise meet
+/// hundreds of extents away, or behind.
+pub const MAX_DEPTH_EXTENTS: f64 = 3.0;
 
 /// The cameras of a COLMAP text model (`cameras.txt`) as the geometry's camera models, by camera
 /// id: the same undistortion the priors use.
@@ -101,6 +113,7 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
         .into_iter()
         .map(|im| (im.name.clone(), im))
         .collect();
+    let max_depth = MAX_DEPTH_EXTENTS * extent(truth.values());
     let names: HashMap<u32, String> = db
         .images()?
         .into_iter()
@@ -139,7 +152,11 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
             .map(|&[a, b]| {
                 let x1 = keypoints[&ids[0]][a as usize];
                 let x2 = keypoints[&ids[1]][b as usize];
-                focal * sampson_distance(&e, &x1, &x2)
+                if meets_in_scene(&r, &t, &x1, &x2, max_depth) {
+                    focal * sampson_distance(&e, &x1, &x2)
+                } else {
+                    f64::INFINITY
+                }
             })
             .collect();
         errors.sort_by(f64::total_cmp);
@@ -150,6 +167,30 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
         labels.insert(pid, Some(median));
     }
     Ok(labels)
+}
+
+/// The diagonal of the bounding box of the cameras' centres.
+fn extent<'a>(images: impl Iterator<Item = &'a model::ModelImage>) -> f64 {
+    let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
+    for im in images {
+        let c = im.centre();
+        lo = lo.inf(&c);
+        hi = hi.sup(&c);
+    }
+    (hi - lo).norm()
+}
+
+/// Whether the rays of normalised points `x1`, `x2` (camera 2 = `r` · camera 1 + `t`) meet in
+/// front of both cameras, nearer than `max_depth` to each.
+fn meets_in_scene(
+    r: &Rotation3<f64>,
+    t: &Vector3<f64>,
+    x1: &[f64; 2],
+    x2: &[f64; 2],
+    max_depth: f64,
+) -> bool {
+    triangulate(r, t, x1, x2)
+        .is_some_and(|p| p.z < max_depth && (r * p + t).z < max_depth)
 }
 
 /// True (epipolar error below [`SAMPSON_THRESHOLD_PX`]), false, or None without ground truth.
@@ -267,7 +308,32 @@ pub fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Rotation3, Vector3};
+
+    /// Two copies of an object seen from the same place relative to each, by cameras 14 m
+    /// apart with the same orientation: each match sits at the same pixel in both images. It
+    /// fits the epipolar geometry of that translation exactly, but its rays never meet in
+    /// front of the cameras (or, a pixel off, hundreds of metres away); a true match meets at
+    /// its point.
+    #[test]
+    fn copies_seen_alike_fit_the_epipolar_lines_but_their_rays_meet_nowhere() {
+        let r = Rotation3::identity();
+        let t = Vector3::new(-14.0, 0.0, 0.0);
+        let e = t.cross_matrix() * r.matrix();
+        let max_depth = MAX_DEPTH_EXTENTS * 14.0;
+        let point = Vector3::new(0.3, -0.2, 4.0);
+        let x1 = [point.x / point.z, point.y / point.z];
+        assert!(400.0 * sampson_distance(&e, &x1, &x1) < 1e-9);
+        assert!(!meets_in_scene(&r, &t, &x1, &x1, max_depth));
+        for shift in [-0.5, 0.5] {
+            let x2 = [x1[0] + shift / 400.0, x1[1]];
+            assert!(400.0 * sampson_distance(&e, &x1, &x2) < 1e-9);
+            assert!(!meets_in_scene(&r, &t, &x1, &x2, max_depth), "{shift}");
+        }
+        let p2 = r * point + t;
+        let x2 = [p2.x / p2.z, p2.y / p2.z];
+        assert!(400.0 * sampson_distance(&e, &x1, &x2) < 1e-9);
+        assert!(meets_in_scene(&r, &t, &x1, &x2, max_depth));
+    }
 
     #[test]
     fn sampson_is_zero_for_true_correspondences_and_large_for_wrong_ones() {
