@@ -171,7 +171,10 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
 
 /// The diagonal of the bounding box of the cameras' centres.
 fn extent<'a>(images: impl Iterator<Item = &'a model::ModelImage>) -> f64 {
-    let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
+    let (mut lo, mut hi) = (
+        Vector3::repeat(f64::INFINITY),
+        Vector3::repeat(f64::NEG_INFINITY),
+    );
     for im in images {
         let c = im.centre();
         lo = lo.inf(&c);
@@ -189,8 +192,7 @@ fn meets_in_scene(
     x2: &[f64; 2],
     max_depth: f64,
 ) -> bool {
-    triangulate(r, t, x1, x2)
-        .is_some_and(|p| p.z < max_depth && (r * p + t).z < max_depth)
+    triangulate(r, t, x1, x2).is_some_and(|p| p.z < max_depth && (r * p + t).z < max_depth)
 }
 
 /// True (epipolar error below [`SAMPSON_THRESHOLD_PX`]), false, or None without ground truth.

@@ -228,7 +228,10 @@ impl Scene {
                 for k in 0..links {
                     let f = k as f64 / (links - 1) as f64;
                     let centre = Vector3::new(-4.2 + 8.4 * f, -4.0, 1.6) + jitter(0.2);
-                    poses.push((centre, Vector3::new(-5.5 + 11.0 * f, 0.0, 0.3) + jitter(0.2)));
+                    poses.push((
+                        centre,
+                        Vector3::new(-5.5 + 11.0 * f, 0.0, 0.3) + jitter(0.2),
+                    ));
                 }
             }
             SceneKind::Symmetric => {
