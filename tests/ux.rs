@@ -339,6 +339,15 @@ fn the_capture_order_is_reported_and_exif_needs_the_images() {
     assert_eq!(by_id["order"]["name"], "image_id");
     assert_eq!(by_id["parameters"]["order"], "image_id");
     assert_eq!(by_graph["order"]["name"], "graph");
+    let (sequence, _) = dry_run(
+        &db,
+        dir.path(),
+        "sequence",
+        &["--preset", "disambiguation", "--sequence_window", "2"],
+    );
+    assert_eq!(by_id["order"]["sequence_window"], 0);
+    assert_eq!(sequence["order"]["sequence_window"], 2);
+    assert_eq!(sequence["parameters"]["sequence_window"], 2);
     for r in [&by_id, &by_graph] {
         let share = r["order"]["selected_within_window"].as_f64().unwrap();
         assert!((0.0..=1.0).contains(&share));

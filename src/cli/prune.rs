@@ -77,6 +77,12 @@ pub struct PruneArgs {
     /// The image folder, read for --order exif.
     #[arg(long, value_name = "DIR")]
     image_path: Option<PathBuf>,
+    /// The images are a sequence in --order (a walk, an orbit, a video) whose images at most W
+    /// positions apart see the same things: backbone_tracks then builds its backbone from each
+    /// image's strongest pairs among those neighbours only, so views of two copies that look
+    /// alike stay out of it (docs/cli.md). 0: the order says nothing about overlap.
+    #[arg(long, value_name = "W", default_value_t = 0)]
+    sequence_window: u32,
 }
 
 impl PruneArgs {
@@ -151,6 +157,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         biconnected: args.flow.biconnected(),
         order: args.order,
         image_path: path_text(&args.image_path),
+        sequence_window: args.sequence_window,
         keep_pairs: path_text(&args.keep_pairs),
         forbid_pairs: path_text(&args.forbid_pairs),
         forbid_images: path_text(&args.forbid_images),

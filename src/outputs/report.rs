@@ -95,6 +95,9 @@ pub struct OrderReport {
     pub window: u32,
     /// With the `exif` order: images without a capture time (placed last, by name).
     pub images_without_time: usize,
+    /// `--sequence_window`: images this many positions apart are neighbours in a capture
+    /// sequence, which backbone_tracks' backbone keeps to (0: not used).
+    pub sequence_window: u32,
 }
 
 /// Spread of one prior's fitness over all images or pairs, and over the selected ones.
@@ -204,6 +207,7 @@ impl Report {
                 view_graph_within_window: share(None),
                 window,
                 images_without_time: order.images_without_time,
+                sequence_window: parameters.sequence_window,
             },
             outputs: Outputs::default(),
             timings: plan.timings.clone(),

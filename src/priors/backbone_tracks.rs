@@ -15,11 +15,18 @@
 //!
 //! Nothing here depends on the image order or on a cut-off of the matcher's statistics; measured
 //! on real photographs and rendered scenes in docs/priors.md.
+//!
+//! Where a copy's view is an image's strongest pair (views of identical objects from the same
+//! side, a symmetric object half an orbit away), that pair enters the backbone and the copies'
+//! tracks join. When the user vouches that the images are a sequence ([`Scene::sequence`]), the
+//! strongest pairs are chosen among each image's neighbours in the sequence only: views of two
+//! copies are far apart in a capture, so no false pair is among them unless two sub-sequences
+//! meet there. The forest then only joins the pieces the sequence leaves apart.
 
 use super::tracks::Tracks;
 use super::PriorValues;
-use crate::scene::view_graph::ViewGraph;
-use crate::scene::Scene;
+use crate::scene::view_graph::{Edge, ViewGraph};
+use crate::scene::{Scene, Sequence};
 use petgraph::unionfind::UnionFind;
 use rayon::prelude::*;
 
@@ -29,7 +36,7 @@ pub const NEIGHBOURS: usize = 3;
 /// Share in [0, 1] of each edge's inliers whose two features are on one backbone track (1 for
 /// backbone edges, 0 without inliers).
 pub fn compute(scene: &Scene) -> PriorValues {
-    let backbone = backbone(scene.graph, &strengths(scene));
+    let backbone = backbone(scene.graph, &strengths(scene), scene.sequence.as_ref());
     let tracks = Tracks::build(scene, |edge| backbone[edge]);
     let values = (0..scene.graph.edges.len())
         .into_par_iter()
@@ -63,27 +70,59 @@ fn strengths(scene: &Scene) -> Vec<f64> {
         .collect()
 }
 
-/// Which edges are in the backbone: the maximum spanning forest of `strength`, and every edge
-/// among the [`NEIGHBOURS`] strongest of both its vertices. Ties go to the lower edge index, so
-/// the backbone is the same on every run.
-pub fn backbone(graph: &ViewGraph, strength: &[f64]) -> Vec<bool> {
-    let mut order: Vec<usize> = (0..graph.edges.len()).collect();
-    order.sort_by(|&a, &b| strength[b].total_cmp(&strength[a]).then(a.cmp(&b)));
-    let mut rank = vec![0usize; order.len()];
-    for (r, &edge) in order.iter().enumerate() {
-        rank[edge] = r;
-    }
-    let mut keep = vec![false; graph.edges.len()];
+/// Which edges are in the backbone: every edge among the [`NEIGHBOURS`] strongest of both its
+/// vertices, and a maximum spanning forest of `strength`. With a `sequence` only neighbours in
+/// it count for the strongest, and the forest joins what they leave apart (sub-sequences whose
+/// ends do not overlap) by neighbours in the sequence first, then by the strongest pairs between
+/// the pieces. Ties go to the lower edge index, so the backbone is the same on every run.
+pub fn backbone(graph: &ViewGraph, strength: &[f64], sequence: Option<&Sequence>) -> Vec<bool> {
+    let near = |e: &Edge| sequence.is_none_or(|s| s.near(e.i, e.j));
+    let mut keep = mutual_strongest(graph, strength, near);
     let mut forest = UnionFind::<u32>::new(graph.num_vertices());
-    for &edge in &order {
+    let mut order = by_strength(strength);
+    if sequence.is_some() {
+        for (e, _) in graph.edges.iter().zip(&keep).filter(|(_, &k)| k) {
+            forest.union(e.i, e.j);
+        }
+        // Stable: by strength within each group.
+        order.sort_by_key(|&edge| !near(&graph.edges[edge]));
+    }
+    for edge in order {
         let e = &graph.edges[edge];
         if forest.union(e.i, e.j) {
             keep[edge] = true;
         }
     }
-    // Each vertex's NEIGHBOURS strongest edges, as the rank of its weakest one.
+    keep
+}
+
+/// Edge indices from the strongest to the weakest, ties to the lower index.
+fn by_strength(strength: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..strength.len()).collect();
+    order.sort_by(|&a, &b| strength[b].total_cmp(&strength[a]).then(a.cmp(&b)));
+    order
+}
+
+/// The edges for which `candidate` holds that are among the [`NEIGHBOURS`] strongest candidates
+/// of both their vertices.
+pub fn mutual_strongest(
+    graph: &ViewGraph,
+    strength: &[f64],
+    candidate: impl Fn(&Edge) -> bool,
+) -> Vec<bool> {
+    let mut rank = vec![0usize; strength.len()];
+    for (r, edge) in by_strength(strength).into_iter().enumerate() {
+        rank[edge] = r;
+    }
+    let is_candidate: Vec<bool> = graph.edges.iter().map(&candidate).collect();
+    // Each vertex's NEIGHBOURS strongest candidates, as the rank of its weakest one.
     let mut incident: Vec<Vec<usize>> = vec![Vec::new(); graph.num_vertices()];
-    for (edge, e) in graph.edges.iter().enumerate() {
+    for (edge, e) in graph
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| is_candidate[*k])
+    {
         incident[e.i as usize].push(rank[edge]);
         incident[e.j as usize].push(rank[edge]);
     }
@@ -94,18 +133,21 @@ pub fn backbone(graph: &ViewGraph, strength: &[f64]) -> Vec<bool> {
             ranks.get(NEIGHBOURS - 1).copied().unwrap_or(usize::MAX)
         })
         .collect();
-    for (edge, e) in graph.edges.iter().enumerate() {
-        if rank[edge] <= cut[e.i as usize] && rank[edge] <= cut[e.j as usize] {
-            keep[edge] = true;
-        }
-    }
-    keep
+    graph
+        .edges
+        .iter()
+        .enumerate()
+        .map(|(edge, e)| {
+            is_candidate[edge] && rank[edge] <= cut[e.i as usize] && rank[edge] <= cut[e.j as usize]
+        })
+        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::testing::{images, pair};
+    use crate::scene::Sequence;
 
     /// A walk of `N` images: background point m (m = 1..=N) is seen by images m..m+REACH-1,
     /// as keypoint (m - k + REACH - 1) * 5 + t (t < 5) of image k. Images 1, 2 see one copy of
@@ -147,7 +189,7 @@ mod tests {
             vec![(100, 100); N as usize],
         );
         let values = compute(&scene).values;
-        let backbone = backbone(&graph, &strengths(&scene));
+        let backbone = backbone(&graph, &strengths(&scene), None);
         let mut true_outside_backbone = 0;
         for (edge, e) in graph.edges.iter().enumerate() {
             let ids = (graph.image_ids[e.i as usize], graph.image_ids[e.j as usize]);
@@ -161,6 +203,97 @@ mod tests {
         }
         // The test means something only if some true pair had to be joined the long way.
         assert!(true_outside_backbone > 0);
+    }
+
+    /// An orbit of 12 views of an object that looks the same after half a turn: each view's
+    /// strongest pair is the one opposite (k, k + 6), false; its true pairs are its neighbours.
+    fn symmetric_orbit() -> (ViewGraph, Vec<f64>) {
+        let mut pairs = Vec::new();
+        for a in 1..=12u32 {
+            for b in a + 1..=12 {
+                let d = (b - a).min(12 - (b - a));
+                if d <= 2 || d == 6 {
+                    pairs.push(pair(a, b, vec![[0, 0]]));
+                }
+            }
+        }
+        let graph = ViewGraph::build(&images(12), &pairs, 1);
+        let strength = graph
+            .edges
+            .iter()
+            .map(|e| match (e.j - e.i).min(12 - (e.j - e.i)) {
+                6 => 150.0,
+                1 => 100.0 + e.i as f64,
+                _ => 80.0 + e.i as f64,
+            })
+            .collect();
+        (graph, strength)
+    }
+
+    #[test]
+    fn a_sequence_keeps_look_alike_views_far_apart_in_it_out_of_the_backbone() {
+        let (graph, strength) = symmetric_orbit();
+        let opposite = |e: &Edge| e.j - e.i == 6;
+        let count = |keep: &[bool], f: &dyn Fn(&Edge) -> bool| {
+            graph
+                .edges
+                .iter()
+                .zip(keep)
+                .filter(|(e, &k)| k && f(e))
+                .count()
+        };
+        // Without the sequence every view's strongest pair is in: the test means something.
+        let plain = backbone(&graph, &strength, None);
+        assert_eq!(count(&plain, &opposite), 6);
+        let sequence = Sequence {
+            rank: (0..12).collect(),
+            window: 2,
+        };
+        let keep = backbone(&graph, &strength, Some(&sequence));
+        assert_eq!(count(&keep, &opposite), 0);
+        // Consecutive views (the ring's 11 in the order, and the 12th across the seam is not
+        // near in it) are all in.
+        assert_eq!(count(&keep, &|e: &Edge| e.j - e.i == 1), 11);
+    }
+
+    #[test]
+    fn a_sequence_joins_its_pieces_by_neighbours_in_it_before_stronger_pairs() {
+        // Two sub-sequences, 1-4 and 5-8, each matched within; between them (4, 6) is near in
+        // the sequence but weaker than every pair within, (1, 8) the strongest pair but far.
+        let mut ids: Vec<(u32, u32)> = vec![(4, 6), (1, 8)];
+        for piece in [1u32, 5] {
+            for a in piece..piece + 4 {
+                ids.extend((a + 1..piece + 4).map(|b| (a, b)));
+            }
+        }
+        ids.sort_unstable();
+        let pairs: Vec<_> = ids.iter().map(|&(a, b)| pair(a, b, vec![[0, 0]])).collect();
+        let graph = ViewGraph::build(&images(8), &pairs, 1);
+        let strength: Vec<f64> = graph
+            .edges
+            .iter()
+            .map(|e| match (e.i + 1, e.j + 1) {
+                (4, 6) => 5.0,
+                (1, 8) => 500.0,
+                _ => 50.0,
+            })
+            .collect();
+        let kept = |keep: &[bool], ids: (u32, u32)| {
+            graph
+                .edges
+                .iter()
+                .zip(keep)
+                .any(|(e, &k)| k && (e.i + 1, e.j + 1) == ids)
+        };
+        let sequence = Sequence {
+            rank: (0..8).collect(),
+            window: 3,
+        };
+        let keep = backbone(&graph, &strength, Some(&sequence));
+        assert!(kept(&keep, (4, 6)) && !kept(&keep, (1, 8)));
+        // Without the sequence the strongest pair joins them, and the weak one is left out.
+        let plain = backbone(&graph, &strength, None);
+        assert!(kept(&plain, (1, 8)) && !kept(&plain, (4, 6)));
     }
 
     #[test]
@@ -186,7 +319,7 @@ mod tests {
                 (i, j) => 10.0 - (j - i) as f64 + 0.01 * i as f64,
             })
             .collect();
-        let keep = backbone(&graph, &strength);
+        let keep = backbone(&graph, &strength, None);
         let kept: Vec<(u32, u32)> = graph
             .edges
             .iter()

@@ -27,6 +27,25 @@ pub struct Scene<'a> {
     /// The raw matches of each edge, oriented from vertex `i` to vertex `j` (empty unless the
     /// multiple-motions prior is computed: it is the only reader, and they are large).
     pub matches: Vec<Vec<[u32; 2]>>,
+    /// The capture sequence the user vouched for (`prune --sequence_window`), if any.
+    pub sequence: Option<Sequence>,
+}
+
+/// Images taken as a sequence (a walk, an orbit, a video): each vertex's position in it, and
+/// how many positions apart images still see the same things.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sequence {
+    /// Position of each vertex, a permutation of `0..n`.
+    pub rank: Vec<u32>,
+    /// Images at most this many positions apart are neighbours.
+    pub window: u32,
+}
+
+impl Sequence {
+    /// Whether vertices `i` and `j` are neighbours in the sequence.
+    pub fn near(&self, i: u32, j: u32) -> bool {
+        self.rank[i as usize].abs_diff(self.rank[j as usize]) <= self.window
+    }
 }
 
 impl<'a> Scene<'a> {
@@ -46,6 +65,7 @@ impl<'a> Scene<'a> {
             camera_ids: Vec::new(),
             geometries: Vec::new(),
             matches: Vec::new(),
+            sequence: None,
         }
     }
 

@@ -51,6 +51,9 @@ pub struct Input {
     pub order: Order,
     /// The image folder, for `Order::Exif`.
     pub image_path: Option<PathBuf>,
+    /// The order is a capture sequence in which images at most this many positions apart see
+    /// the same things (`--sequence_window`); 0: it says nothing about overlap.
+    pub sequence_window: u32,
 }
 
 /// The order as computed: each view-graph vertex's position.
@@ -375,6 +378,7 @@ mod tests {
         let input = Input {
             order,
             image_path: dir.map(Path::to_path_buf),
+            ..Default::default()
         };
         let computed = compute(&input, &graph, &images, &pairs)?;
         Ok(sequence(&computed, &graph, &images))

@@ -52,6 +52,10 @@ pub struct Parameters {
     /// The image folder read for the `exif` order.
     #[serde(default)]
     pub image_path: Option<String>,
+    /// Images at most this many positions apart in `order` are neighbours in a capture
+    /// sequence (0, and in older records: the order says nothing about overlap).
+    #[serde(default)]
+    pub sequence_window: u32,
     /// The override files given (paths as given), for the record.
     pub keep_pairs: Option<String>,
     /// See `keep_pairs`.
@@ -79,6 +83,7 @@ impl Parameters {
             biconnected: Some(false),
             order: Order::default(),
             image_path: None,
+            sequence_window: 0,
             keep_pairs: None,
             forbid_pairs: None,
             forbid_images: None,
@@ -111,6 +116,7 @@ impl Parameters {
             capture: capture_order::Input {
                 order: self.order,
                 image_path: self.image_path.as_ref().map(Into::into),
+                sequence_window: self.sequence_window,
             },
         }
     }

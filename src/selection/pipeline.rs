@@ -12,7 +12,7 @@ use crate::geometry::camera::CameraModel;
 use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, PriorValues};
 use crate::scene::view_graph::ViewGraph;
-use crate::scene::Scene;
+use crate::scene::{Scene, Sequence};
 use crate::selection::capture_order::{self, CaptureOrder};
 use crate::selection::overrides::{Listed, Overrides};
 use crate::selection::parameters::Parameters;
@@ -173,8 +173,13 @@ pub fn plan_with(
     }
     let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
     let names = options.model.pair_prior_names(options.unweighted_priors);
-    let scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
+    let mut scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
     let order = capture_order::compute(&options.capture, &graph, &images, &pairs)?;
+    let window = options.capture.sequence_window;
+    scene.sequence = (window > 0).then(|| Sequence {
+        rank: order.rank.clone(),
+        window,
+    });
     timings.read = started.elapsed().as_secs_f64();
 
     stage("computing priors");
