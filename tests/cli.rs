@@ -253,6 +253,33 @@ fn bad_input_fails_with_one_line_and_changes_nothing() {
     assert_eq!(std::fs::read(&db).unwrap(), bytes);
 }
 
+/// At the maximum flow every unit runs through its own image and no pair arc is used: a fixed
+/// --flow that large would invalidate every pair. It is refused, with the database untouched;
+/// a dry run still reports the empty selection.
+#[test]
+fn a_flow_that_keeps_no_pair_is_refused() {
+    let (_dir, db) = scene();
+    let bytes = std::fs::read(&db).unwrap();
+    let message = fails(&["prune", "--database_path", s(&db), "--flow", "100000"]);
+    assert!(
+        message.contains("keeps none") && message.contains("smaller --flow"),
+        "{message}"
+    );
+    assert_eq!(std::fs::read(&db).unwrap(), bytes);
+    let out = ok(&[
+        "prune",
+        "--database_path",
+        s(&db),
+        "--flow",
+        "100000",
+        "--dry_run",
+    ]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("selected 0 of"));
+    // A flow that keeps pairs still writes.
+    ok(&["prune", "--database_path", s(&db), "--flow", "2", "-q"]);
+    assert_ne!(std::fs::read(&db).unwrap(), bytes);
+}
+
 #[test]
 fn dashed_option_names_work_too() {
     let (_dir, db) = scene();

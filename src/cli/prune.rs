@@ -177,6 +177,22 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         plan.network.problem.pairs.len(),
         plan.search.selection.flow
     ));
+    let kept = plan.search.selection.pairs.iter().filter(|&&k| k).count();
+    if kept == 0 && !args.dry_run {
+        let why = match parameters.flow {
+            // Every unit beyond the flows that chain images takes its own image's arc, and at
+            // the maximum, twice the network's pairs, no pair arc carries flow.
+            Some(f) => format!(
+                "--flow {f} is too large: past some F the selection shrinks, and at F = {} it is empty; use a smaller --flow or the default search",
+                2 * plan.network.problem.pairs.len()
+            ),
+            None => "the overrides and the fitness floor leave no pair to select".to_string(),
+        };
+        bail!(
+            "the selection keeps none of the {} pairs, so the mapper would have nothing to start from ({why}); nothing written",
+            plan.graph.edges.len()
+        );
+    }
     // The extra files first: if one cannot be written, the database is still untouched.
     let mut outputs = Outputs::default();
     if let Some(path) = &args.pairs_out {
