@@ -117,10 +117,33 @@ fn every_image_keeps_its_long_track_keypoints() {
             .filter(|(v, &f)| kept.get(v).copied().unwrap_or(0) < f.div_ceil(2).min(n))
             .count()
     };
-    // Without the completion images are short of it, so the test below is not met by accident.
-    let (plain, report) = prune("plain.db", "0");
-    assert!(short_of(&plain, 400) > 0);
+    // Without the completion the flow keeps no pair (a prune that would write that is refused;
+    // a dry run reports it) and every image is short, so the test below is not met by accident.
+    let report = dir.path().join("plain.json");
+    ok(&[
+        "prune",
+        "--database_path",
+        db.to_str().unwrap(),
+        "--dry_run",
+        "-q",
+        "--report",
+        report.to_str().unwrap(),
+        "--min_image_fraction",
+        "0",
+        "--min_pairs_per_image",
+        "0",
+        "--min_track_length_ratio",
+        "0",
+        "--spanning_forests",
+        "0",
+        "--min_track_observations",
+        "0",
+    ]);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(report["pairs_selected"], 0);
     assert!(report["completion"].is_null());
+    assert!(short_of(&HashMap::new(), 400) > 0);
     for n in [100, 400] {
         let (kept, report) = prune(&format!("n{n}.db"), &n.to_string());
         assert_eq!(short_of(&kept, n), 0, "N = {n}");

@@ -186,7 +186,10 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
                 "--flow {f} is too large: past some F the selection shrinks, and at F = {} it is empty; use a smaller --flow or the default search",
                 2 * plan.network.problem.pairs.len()
             ),
-            None => "the overrides and the fitness floor leave no pair to select".to_string(),
+            None if plan.network.problem.pairs.is_empty() => {
+                "the overrides and the fitness floor leave no pair to select".to_string()
+            }
+            None => "the search's criteria are met without a pair: ask for images or pairs (--min_image_fraction, --min_pairs_per_image) or the track completion".to_string(),
         };
         bail!(
             "the selection keeps none of the {} pairs, so the mapper would have nothing to start from ({why}); nothing written",
