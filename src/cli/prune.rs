@@ -189,7 +189,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
             None if plan.network.problem.pairs.is_empty() => {
                 "the overrides and the fitness floor leave no pair to select".to_string()
             }
-            None => "the search's criteria are met without a pair: ask for images or pairs (--min_image_fraction, --min_pairs_per_image) or the track completion".to_string(),
+            None => "the search's criteria are met without a pair: ask for images or pairs (--min_image_fraction, --min_pairs_per_image) or turn on the track completion (--min_track_observations)".to_string(),
         };
         bail!(
             "the selection keeps none of the {} pairs, so the mapper would have nothing to start from ({why}); nothing written",

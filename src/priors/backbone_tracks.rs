@@ -105,7 +105,7 @@ fn by_strength(strength: &[f64]) -> Vec<usize> {
 
 /// The edges for which `candidate` holds that are among the [`NEIGHBOURS`] strongest candidates
 /// of both their vertices.
-pub fn mutual_strongest(
+fn mutual_strongest(
     graph: &ViewGraph,
     strength: &[f64],
     candidate: impl Fn(&Edge) -> bool,
