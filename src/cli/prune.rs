@@ -80,7 +80,8 @@ pub struct PruneArgs {
     /// The images are a sequence in --order (a walk, an orbit, a video) whose images at most W
     /// positions apart see the same things: backbone_tracks then builds its backbone from each
     /// image's strongest pairs among those neighbours only, so views of two copies that look
-    /// alike stay out of it (docs/cli.md). 0: the order says nothing about overlap.
+    /// alike stay out of it (docs/cli.md; 2 to 8 repaired the measured symmetric orbit). 0: the
+    /// order says nothing about overlap.
     #[arg(long, value_name = "W", default_value_t = 0)]
     sequence_window: u32,
 }
