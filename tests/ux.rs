@@ -348,6 +348,16 @@ fn the_capture_order_is_reported_and_exif_needs_the_images() {
     assert_eq!(by_id["order"]["sequence_window"], 0);
     assert_eq!(sequence["order"]["sequence_window"], 2);
     assert_eq!(sequence["parameters"]["sequence_window"], 2);
+    // Only the backbone_tracks prior reads the sequence: a preset without it is told so.
+    let before = std::fs::read(&db).unwrap();
+    let out = vgsel(&["prune", "--database_path", s(&db), "--sequence_window", "2"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("backbone_tracks") && err.lines().count() == 1,
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&db).unwrap(), before);
     for r in [&by_id, &by_graph] {
         let share = r["order"]["selected_within_window"].as_f64().unwrap();
         assert!((0.0..=1.0).contains(&share));

@@ -137,6 +137,12 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     if let Some(floor) = args.min_pair_fitness {
         model.min_pair_fitness = floor;
     }
+    if args.sequence_window > 0 && !model.pair_prior_names(false).contains(&"backbone_tracks") {
+        bail!(
+            "--sequence_window shapes the backbone_tracks prior, which --preset {} does not weigh (use --preset disambiguation, or give it a weight with --weights)",
+            args.preset.name()
+        );
+    }
     let path_text = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     let (flow, given) = args.flow.parts(args.preset.criteria());
     let parameters = Parameters {
