@@ -407,35 +407,46 @@ fn dot_costs(dot: &str) -> std::collections::BTreeMap<(u32, u32), f64> {
 
 #[test]
 fn export_shows_the_costs_that_drove_the_selection() {
-    // Pruned with the disambiguation preset and a weight override: the exported costs must be
-    // those of that cost model (as --scores wrote them), not the general preset's.
+    // Pruned with the disambiguation preset and a weight override, or with a sequence window
+    // (which makes the order shape the costs): the exported costs must be those of that run (as
+    // --scores wrote them), not the general preset's or those without the window.
     let (dir, db) = scene();
-    let pruned = dir.path().join("pruned.db");
-    let scores = dir.path().join("scores.csv");
-    let disambiguation = ["--preset", "disambiguation", "--weights", "loop_fraction=2"];
-    prune_copy(
-        &db,
-        &pruned,
-        &[&disambiguation[..], &["--scores", s(&scores)]].concat(),
+    let costs_of = |args: &[&str], tag: &str| {
+        let pruned = dir.path().join(format!("{tag}.db"));
+        let scores = dir.path().join(format!("{tag}.csv"));
+        prune_copy(&db, &pruned, &[args, &["--scores", s(&scores)]].concat());
+        let csv = std::fs::read_to_string(&scores).unwrap();
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let cost_column = header.iter().position(|&h| h == "cost").unwrap();
+        let expected: std::collections::BTreeMap<(u32, u32), f64> = csv
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let f: Vec<&str> = l.split(',').collect();
+                (
+                    (f[0].parse().unwrap(), f[1].parse().unwrap()),
+                    f[cost_column].parse().unwrap(),
+                )
+            })
+            .collect();
+        let dot = dir.path().join(format!("{tag}.dot"));
+        assert_eq!(dot_costs(&export(&pruned, "dot", &dot)), expected, "{tag}");
+        expected
+    };
+    let weighted = costs_of(
+        &["--preset", "disambiguation", "--weights", "loop_fraction=2"],
+        "weighted",
     );
-    let csv = std::fs::read_to_string(&scores).unwrap();
-    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let cost_column = header.iter().position(|&h| h == "cost").unwrap();
-    let expected: std::collections::BTreeMap<(u32, u32), f64> = csv
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (
-                (f[0].parse().unwrap(), f[1].parse().unwrap()),
-                f[cost_column].parse().unwrap(),
-            )
-        })
-        .collect();
-    let exported = dot_costs(&export(&pruned, "dot", &dir.path().join("g.dot")));
-    assert_eq!(exported, expected);
-    // And they differ from the general preset's, so the check above can fail.
+    let plain = costs_of(&["--preset", "disambiguation"], "plain");
+    let sequence = costs_of(
+        &["--preset", "disambiguation", "--sequence_window", "1"],
+        "sequence",
+    );
+    // And the runs' costs differ from each other and from the general preset's, so the checks
+    // above can fail.
     let general = dot_costs(&export(&db, "dot", &dir.path().join("general.dot")));
-    assert_eq!(general.len(), expected.len());
-    assert_ne!(general, expected);
+    assert_eq!(general.len(), weighted.len());
+    assert_ne!(general, weighted);
+    assert_ne!(plain, weighted);
+    assert_ne!(plain, sequence);
 }

@@ -137,11 +137,17 @@ pub fn last_plan(db: &Database, stage: &dyn Fn(&str)) -> Result<Plan> {
         None => Parameters::of_preset(Preset::General, DEFAULT_MIN_NUM_MATCHES),
     };
     // No flow runs, so the order, which only orients the arcs, is image_id's: it needs no image
-    // files (an EXIF order would).
+    // files (an EXIF order would). Unless a sequence window made the order shape the backbone
+    // and so the costs: then it is the recorded one.
+    let recorded = parameters.options(true);
+    let capture = match recorded.capture.sequence_window {
+        0 => Default::default(),
+        _ => recorded.capture.clone(),
+    };
     let options = Options {
         rule: FlowRule::Fixed(0),
-        capture: Default::default(),
-        ..parameters.options(true)
+        capture,
+        ..recorded
     };
     plan_with(db, &options, &Overrides::default(), stage)
 }
