@@ -92,24 +92,20 @@ fn every_image_keeps_its_long_track_keypoints() {
     let full = long_track_keypoints(&db);
     assert_eq!(full.len(), 16, "every image of the scene is on long tracks");
     // The flow selects nothing (F = 0): what is kept is the completion's.
+    // The flow's criteria and the completion's other needs off.
+    let others_off = [
+        "--min_image_fraction",
+        "0",
+        "--min_pairs_per_image",
+        "0",
+        "--min_track_length_ratio",
+        "0",
+        "--spanning_forests",
+        "0",
+    ];
     let prune = |name: &str, n: &str| {
-        let (out, report) = prune(
-            dir.path(),
-            &db,
-            name,
-            &[
-                "--min_image_fraction",
-                "0",
-                "--min_pairs_per_image",
-                "0",
-                "--min_track_length_ratio",
-                "0",
-                "--spanning_forests",
-                "0",
-                "--min_track_observations",
-                n,
-            ],
-        );
+        let args = [&others_off[..], &["--min_track_observations", n]].concat();
+        let (out, report) = prune(dir.path(), &db, name, &args);
         (long_track_keypoints(&out), report)
     };
     let short_of = |kept: &HashMap<u32, usize>, n: usize| {
@@ -120,7 +116,7 @@ fn every_image_keeps_its_long_track_keypoints() {
     // Without the completion the flow keeps no pair (a prune that would write that is refused;
     // a dry run reports it) and every image is short, so the test below is not met by accident.
     let report = dir.path().join("plain.json");
-    ok(&[
+    let dry_run = [
         "prune",
         "--database_path",
         db.to_str().unwrap(),
@@ -128,17 +124,10 @@ fn every_image_keeps_its_long_track_keypoints() {
         "-q",
         "--report",
         report.to_str().unwrap(),
-        "--min_image_fraction",
-        "0",
-        "--min_pairs_per_image",
-        "0",
-        "--min_track_length_ratio",
-        "0",
-        "--spanning_forests",
-        "0",
         "--min_track_observations",
         "0",
-    ]);
+    ];
+    ok(&[&dry_run[..], &others_off[..]].concat());
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(report["pairs_selected"], 0);

@@ -348,30 +348,23 @@ fn the_capture_order_is_reported_and_exif_needs_the_images() {
     assert_eq!(by_id["order"]["sequence_window"], 0);
     assert_eq!(sequence["order"]["sequence_window"], 2);
     assert_eq!(sequence["parameters"]["sequence_window"], 2);
+    // A prune that fails says why in one line and leaves the database as it was.
+    let fails_with = |args: &[&str], needle: &str| {
+        let before = std::fs::read(&db).unwrap();
+        let out = vgsel(&[&["prune", "--database_path", s(&db)][..], args].concat());
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle) && err.lines().count() == 1, "{err}");
+        assert_eq!(std::fs::read(&db).unwrap(), before);
+    };
     // Only the backbone_tracks prior reads the sequence: a preset without it is told so.
-    let before = std::fs::read(&db).unwrap();
-    let out = vgsel(&["prune", "--database_path", s(&db), "--sequence_window", "2"]);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("backbone_tracks") && err.lines().count() == 1,
-        "{err}"
-    );
-    assert_eq!(std::fs::read(&db).unwrap(), before);
+    fails_with(&["--sequence_window", "2"], "backbone_tracks");
     for r in [&by_id, &by_graph] {
         let share = r["order"]["selected_within_window"].as_f64().unwrap();
         assert!((0.0..=1.0).contains(&share));
         assert_eq!(r["order"]["window"], 5);
     }
-    let before = std::fs::read(&db).unwrap();
-    let out = vgsel(&["prune", "--database_path", s(&db), "--order", "exif"]);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("--image_path") && err.lines().count() == 1,
-        "{err}"
-    );
-    assert_eq!(std::fs::read(&db).unwrap(), before);
+    fails_with(&["--order", "exif"], "--image_path");
 }
 
 /// The `cost` attribute of every DOT edge, keyed by the edge's image ids.
