@@ -15,6 +15,7 @@ use crate::colmap::database::{Camera, Database};
 use crate::colmap::ids::image_ids;
 use crate::colmap::ids::{camera_model_id, camera_model_num_params};
 use crate::colmap::model;
+use crate::eval::align::scene_extent;
 use crate::geometry::camera::CameraModel;
 use crate::geometry::pose::{sampson_distance, triangulate};
 use anyhow::{ensure, Context, Result};
@@ -28,7 +29,7 @@ use std::path::Path;
 pub const SAMPSON_THRESHOLD_PX: f64 = 4.0;
 
 /// An inlier's rays must meet within this many times the extent of the ground truth's camera
-/// centres (the diagonal of their bounding box): every surface of the rendered scenes, and of
+/// centres (their largest distance, [`scene_extent`], as the correctness thresholds use): every surface of the rendered scenes, and of
 /// the photographed ones, lies well within it, and rays that are parallel up to noise meet
 /// hundreds of extents away, or behind.
 pub const MAX_DEPTH_EXTENTS: f64 = 3.0;
@@ -113,7 +114,8 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
         .into_iter()
         .map(|im| (im.name.clone(), im))
         .collect();
-    let max_depth = MAX_DEPTH_EXTENTS * extent(truth.values());
+    let centres: Vec<_> = truth.values().map(model::ModelImage::centre).collect();
+    let max_depth = MAX_DEPTH_EXTENTS * scene_extent(&centres);
     let names: HashMap<u32, String> = db
         .images()?
         .into_iter()
@@ -167,20 +169,6 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
         labels.insert(pid, Some(median));
     }
     Ok(labels)
-}
-
-/// The diagonal of the bounding box of the cameras' centres.
-fn extent<'a>(images: impl Iterator<Item = &'a model::ModelImage>) -> f64 {
-    let (mut lo, mut hi) = (
-        Vector3::repeat(f64::INFINITY),
-        Vector3::repeat(f64::NEG_INFINITY),
-    );
-    for im in images {
-        let c = im.centre();
-        lo = lo.inf(&c);
-        hi = hi.sup(&c);
-    }
-    (hi - lo).norm()
 }
 
 /// Whether the rays of normalised points `x1`, `x2` (camera 2 = `r` · camera 1 + `t`) meet in
