@@ -77,9 +77,9 @@ fn strengths(scene: &Scene) -> Vec<f64> {
 /// the pieces. Ties go to the lower edge index, so the backbone is the same on every run.
 pub fn backbone(graph: &ViewGraph, strength: &[f64], sequence: Option<&Sequence>) -> Vec<bool> {
     let near = |e: &Edge| sequence.is_none_or(|s| s.near(e.i, e.j));
-    let mut keep = mutual_strongest(graph, strength, near);
-    let mut forest = UnionFind::<u32>::new(graph.num_vertices());
     let mut order = by_strength(strength);
+    let mut keep = mutual_strongest(graph, &order, near);
+    let mut forest = UnionFind::<u32>::new(graph.num_vertices());
     if sequence.is_some() {
         for (e, _) in graph.edges.iter().zip(&keep).filter(|(_, &k)| k) {
             forest.union(e.i, e.j);
@@ -104,14 +104,14 @@ fn by_strength(strength: &[f64]) -> Vec<usize> {
 }
 
 /// The edges for which `candidate` holds that are among the [`NEIGHBOURS`] strongest candidates
-/// of both their vertices.
+/// of both their vertices; `order` lists the edges strongest first ([`by_strength`]).
 fn mutual_strongest(
     graph: &ViewGraph,
-    strength: &[f64],
+    order: &[usize],
     candidate: impl Fn(&Edge) -> bool,
 ) -> Vec<bool> {
-    let mut rank = vec![0usize; strength.len()];
-    for (r, edge) in by_strength(strength).into_iter().enumerate() {
+    let mut rank = vec![0usize; order.len()];
+    for (r, &edge) in order.iter().enumerate() {
         rank[edge] = r;
     }
     let is_candidate: Vec<bool> = graph.edges.iter().map(&candidate).collect();
