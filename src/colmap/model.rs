@@ -20,6 +20,9 @@ pub struct ModelImage {
     pub rotation: UnitQuaternion<f64>,
     /// World-to-camera translation.
     pub translation: Vector3<f64>,
+    /// Keypoints of the image on a 3D point of the model: the image's share of the bundle
+    /// adjustment's residuals.
+    pub observations: usize,
 }
 
 impl ModelImage {
@@ -165,9 +168,16 @@ fn read_text_images(dir: &Path) -> Result<Vec<ModelImage>> {
             name: tok[9..].join(" "),
             rotation: UnitQuaternion::from_quaternion(q),
             translation: Vector3::new(num(5)?, num(6)?, num(7)?),
+            // The 2D-point line (may be empty): X Y POINT3D_ID triples, -1 for no point.
+            observations: lines.next().map_or(0, |(_, points)| {
+                points
+                    .split_whitespace()
+                    .skip(2)
+                    .step_by(3)
+                    .filter(|id| *id != "-1")
+                    .count()
+            }),
         });
-        // The 2D-point line (may be empty).
-        lines.next();
     }
     Ok(out)
 }
@@ -224,7 +234,12 @@ fn read_binary_images(dir: &Path) -> Result<Vec<ModelImage>> {
         let camera_id = r.u32()?;
         let name = r.name()?;
         let points = r.u64()?;
-        r.skip(points.checked_mul(24).context("corrupt point count")? as usize)?;
+        let mut observations = 0;
+        for _ in 0..points {
+            r.skip(16)?;
+            // COLMAP's invalid point id is u64::MAX (-1 as i64).
+            observations += usize::from(r.u64()? != u64::MAX);
+        }
         out.push(ModelImage {
             image_id,
             camera_id,
@@ -233,6 +248,7 @@ fn read_binary_images(dir: &Path) -> Result<Vec<ModelImage>> {
                 q[0], q[1], q[2], q[3],
             )),
             translation: Vector3::new(t[0], t[1], t[2]),
+            observations,
         });
     }
     Ok(out)
@@ -296,7 +312,7 @@ mod tests {
             dir.path().join("images.txt"),
             "# comment\n# Number of images: 2\n\
              1 1 0 0 0 1 2 3 1 a.jpg\n\
-             10.5 20.5 -1\n\
+             10.5 20.5 -1 11.5 2.5 4 1.5 3.5 9\n\
              2 0 1 0 0 0 0 1 1 b c.jpg\n\n",
         )
         .unwrap();
@@ -304,6 +320,7 @@ mod tests {
         assert_eq!(images.len(), 2);
         assert_eq!(images[0].name, "a.jpg");
         assert_eq!(images[1].name, "b c.jpg");
+        assert_eq!((images[0].observations, images[1].observations), (2, 0));
         assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
         assert!((images[1].centre() - Vector3::new(0.0, 0.0, 1.0)).norm() < 1e-12);
     }
@@ -324,6 +341,7 @@ mod tests {
             name: "a b.jpg".into(),
             rotation: UnitQuaternion::from_euler_angles(0.1, -0.2, 0.3),
             translation: Vector3::new(1.0, -2.0, 0.5),
+            observations: 0,
         };
         write_text_model(
             dir.path(),
@@ -351,8 +369,12 @@ mod tests {
         }
         bin.extend(2u32.to_le_bytes());
         bin.extend(b"a b.png\0");
-        bin.extend(1u64.to_le_bytes());
-        bin.extend([0u8; 24]);
+        // Three 2D points, the second on no 3D point.
+        bin.extend(3u64.to_le_bytes());
+        for id in [5u64, u64::MAX, 0] {
+            bin.extend([0u8; 16]);
+            bin.extend(id.to_le_bytes());
+        }
         std::fs::write(model.join("images.bin"), &bin).unwrap();
         assert_eq!(model_dirs(dir.path()).unwrap(), vec![model.clone()]);
         let images = read_images(&model).unwrap();
@@ -364,6 +386,7 @@ mod tests {
             ),
             (7, 2, "a b.png")
         );
+        assert_eq!(images[0].observations, 2);
         assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
         std::fs::write(model.join("images.bin"), &bin[..bin.len() - 1]).unwrap();
         assert!(read_images(&model)

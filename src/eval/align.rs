@@ -406,6 +406,7 @@ mod tests {
             name,
             rotation: UnitQuaternion::from_rotation_matrix(&p.rotation),
             translation: -(p.rotation * p.centre),
+            observations: 0,
         };
         let tilt = Similarity {
             scale: 1.0,

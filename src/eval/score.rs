@@ -46,6 +46,9 @@ pub struct Scores {
     pub median_position_error: Option<f64>,
     /// Median rotation error over registered images (degrees); null when none.
     pub median_rotation_error_deg: Option<f64>,
+    /// 2D observations of 3D points over all sub-models: what the mapper's bundle adjustments
+    /// work on, so what a prune can save of their time.
+    pub observations: usize,
     /// Every ground-truth image's score, registered or not.
     pub images: Vec<ImageScore>,
 }
@@ -62,8 +65,10 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
     );
     let dirs = model::model_dirs(sparse)?;
     let mut best: HashMap<String, ImageScore> = HashMap::new();
+    let mut observations = 0;
     for (index, dir) in dirs.iter().enumerate() {
         let estimated = model::read_images(dir)?;
+        observations += estimated.iter().map(|im| im.observations).sum::<usize>();
         // A model of fewer than 2 known images cannot be aligned: its images stay unscored.
         let Ok(eval) = align::evaluate(&estimated, &truth) else {
             continue;
@@ -98,6 +103,7 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
         correct: images.iter().filter(|s| s.correct).count(),
         median_position_error: median(images.iter().map(|s| s.position_error).collect()),
         median_rotation_error_deg: median(images.iter().map(|s| s.rotation_error_deg).collect()),
+        observations,
         images,
     })
 }

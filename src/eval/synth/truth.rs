@@ -85,6 +85,7 @@ impl GroundTruth {
                 name: im.name.clone(),
                 rotation: UnitQuaternion::from_rotation_matrix(&im.rotation),
                 translation: im.translation,
+                observations: 0,
             })
             .collect()
     }
