@@ -8,15 +8,36 @@ writes WORK/summary.json and the same table in Markdown, as the README shows it,
 """
 import json
 import os
+import re
 import statistics
 import sys
 
+# Seconds a mapper spends optimising over all its observations, from its log: COLMAP 3.8's bundle
+# adjustment reports ("Time : 0.04 [s]"); COLMAP 4.2's global positioning and bundle adjustment
+# stages ("... done in 1.9 seconds"; not its retriangulation, which also walks every pair's
+# correspondences).
+OPTIMISATION = re.compile(r"^\s+Time : ([0-9.e+-]+) \[s\]|"
+                          r"(?:Global positioning|Iterative bundle adjustment) done in ([0-9.e+-]+)",
+                          re.M)
+
+
+def optimisation_seconds(log):
+    """Wall seconds in bundle adjustment and global positioning, or None without a log."""
+    try:
+        text = open(log).read()
+    except OSError:
+        return None
+    return sum(float(a or b) for a, b in OPTIMISATION.findall("\n".join(
+        line[line.find("]") + 1:] if line.startswith(("I2", "W2")) else line
+        for line in text.splitlines())))
+
 
 def load_run(d):
-    """(wall seconds, CPU seconds, eval) of one mapper run, or None when it failed."""
+    """(wall seconds, CPU seconds, eval, optimisation seconds) of one mapper run, or None when it
+    failed."""
     try:
         wall, cpu = map(float, open(f"{d}/seconds").read().split())
-        return wall, cpu, json.load(open(f"{d}/eval.json"))
+        return wall, cpu, json.load(open(f"{d}/eval.json")), optimisation_seconds(f"{d}/mapper.log")
     except (OSError, ValueError):
         return None
 
@@ -38,6 +59,9 @@ def variant_row(runs):
         "images": ev[0]["images_ground_truth"],
         "pos": median(e["median_position_error"] for e in ev),
         "rot": median(e["median_rotation_error_deg"] for e in ev),
+        # What the bundle adjustments work on (None from an eval before session 8).
+        "observations": median(e.get("observations") for e in ev),
+        "optimisation": median(r[3] for r in runs),
     }
 
 
@@ -62,17 +86,19 @@ def markdown_row(scene, mapper, pairs, full, pruned, ratio, why):
     arrow = lambda key, spec: f"{fmt(full[key], spec)} → {fmt(pruned[key], spec)}"
     return (f"| {scene} | {mapper} | {pairs['full']} → {pairs['pruned']} | "
             f"{arrow('cpu', '%.1f')} | {ratio:.2f}x | {arrow('registered', '%g')} | "
-            f"{arrow('correct', '%g')} | {arrow('pos', '%.1e')} | {arrow('rot', '%.2f')} | {why} |")
+            f"{arrow('correct', '%g')} | {arrow('pos', '%.1e')} | {arrow('rot', '%.2f')} | "
+            f"{arrow('observations', '%d')} | {arrow('optimisation', '%.1f')} | {why} |")
 
 
 def main():
     work, runs, scenes = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
     print(f"{'scene':<10} {'mapper':<8} {'db':<6} {'pairs':>5} {'wall s':>7} {'CPU s':>7} "
-          f"{'ratio':>5} {'registered':>10} {'correct':>7} {'med. pos':>8} {'med. rot':>8}  verdict")
+          f"{'ratio':>5} {'registered':>10} {'correct':>7} {'med. pos':>8} {'med. rot':>8} "
+          f"{'obs.':>7} {'opt. s':>6}  verdict")
     summary = {}
     markdown = ["| scene | mapper | pairs full → pruned | CPU s full → pruned | ratio | registered | "
-                "correct | med. pos. error | med. rot. error | verdict |",
-                "|---|---|---|---|---|---|---|---|---|---|"]
+                "correct | med. pos. error | med. rot. error | observations | optimisation s | verdict |",
+                "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for scene in scenes:
         base = f"{work}/{scene}"
         if not os.path.exists(f"{base}/prune.json"):
@@ -96,7 +122,9 @@ def main():
                 print(f"{scene:<10} {mapper:<8} {variant:<6} {pairs[variant]:>5} {r['wall']:>7.1f} "
                       f"{r['cpu']:>7.1f} {'%.2f' % ratio if last else '':>5} "
                       f"{'%g/%d' % (r['registered'], r['images']):>10} {r['correct']:>7g} "
-                      f"{fmt(r['pos'], '%.1e'):>8} {fmt(r['rot'], '%.3f'):>8}  {why if last else ''}")
+                      f"{fmt(r['pos'], '%.1e'):>8} {fmt(r['rot'], '%.3f'):>8} "
+                      f"{fmt(r['observations'], '%d'):>7} {fmt(r['optimisation'], '%.1f'):>6}  "
+                      f"{why if last else ''}")
             markdown.append(markdown_row(scene, mapper, pairs, full, pruned, ratio, why))
             binding = [c for c in prune["criteria"] if c.get("binding")]
             summary[f"{scene}/{mapper}"] = {
