@@ -73,7 +73,13 @@ def verdict(full, pruned, ratio):
     if not within(pruned["pos"], full["pos"]) or not within(pruned["rot"], full["rot"]):
         problems.append("errors > 1.5x")
     if ratio < 2:
-        problems.append("< 2x")
+        # Why, where the logs tell: the share of the full run spent optimising over the
+        # observations, and the share of those the prune kept.
+        why = ""
+        if full["optimisation"] and full["wall"] and full["observations"] and pruned["observations"]:
+            why = (f" (optimising {full['optimisation'] / full['wall']:.0%} of the full run, "
+                   f"{pruned['observations'] / full['observations']:.0%} of its observations kept)")
+        problems.append("< 2x" + why)
     return ", ".join(problems) or "pass"
 
 
