@@ -62,7 +62,7 @@ pub struct FlowArgs {
     min_track_length_ratio: Option<f64>,
     /// After the search, first add this many maximum spanning forests of the view graph by
     /// inliers (each of the pairs the ones before left), so that no part of the scene hangs on
-    /// weak pairs [default: 3, other presets 0].
+    /// weak pairs [default: 5, other presets 0].
     #[arg(long)]
     spanning_forests: Option<usize>,
     /// Search: ... and no image cuts the selection apart: it stays connected without any one

@@ -64,9 +64,13 @@ impl Preset {
     /// may be false ones (the disambiguation presets).
     pub fn spanning_forests(self) -> usize {
         match self {
-            // Chosen on templeRing with COLMAP 4.2's global mapper (one or two forests: 24
-            // cameras correct, three: 31 as on the full graph; docs/performance.md).
-            Preset::General => 3,
+            // Three were chosen on templeRing with COLMAP 4.2's global mapper (one or two: 24
+            // cameras correct, three: 31 as on the full graph); five since session 8: the global
+            // mapper's first bundle adjustment starts from a rougher estimate on a sparser graph,
+            // and with three it was slower than on the full graph on 8 of 16 benchmark rows (down
+            // to 0.64x), with five on 2 (0.93x, 0.99x); geometric mean speed-ups with three and
+            // five: COLMAP 3.8 1.16x and 1.18x, global 1.01x and 1.15x (docs/performance.md).
+            Preset::General => 5,
             Preset::Disambiguation | Preset::PaperDisambiguation => 0,
         }
     }
