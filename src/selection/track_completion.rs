@@ -9,7 +9,8 @@
 //!    through pairs of 15 to 37 inliers while pairs of over 1,000 joined the same parts, and the
 //!    COLMAP 3.8 mapper split the scene in two models (24 and 14 of 47 images). One forest mended
 //!    that; COLMAP 4.2's global mapper still placed 7 more cameras wrongly than on the full
-//!    graph with one or two forests, and as many as the full graph with three.
+//!    graph with one or two forests, and as many as the full graph with three; with five (the
+//!    default) its first bundle adjustment also starts from a better-posed graph (session 8).
 //! 2. Registrability: every image keeps N keypoints on tracks of three or more observations, or
 //!    half of those it has on such tracks through the selectable pairs (all, less those forbidden
 //!    or below the fitness floor) if that is fewer. The mapper registers an image from 2D-3D
