@@ -27,9 +27,7 @@ def optimisation_seconds(log):
         text = open(log).read()
     except OSError:
         return None
-    return sum(float(a or b) for a, b in OPTIMISATION.findall("\n".join(
-        line[line.find("]") + 1:] if line.startswith(("I2", "W2")) else line
-        for line in text.splitlines())))
+    return sum(float(a or b) for a, b in OPTIMISATION.findall(text))
 
 
 def load_run(d):
