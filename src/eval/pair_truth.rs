@@ -29,9 +29,9 @@ use std::path::Path;
 pub const SAMPSON_THRESHOLD_PX: f64 = 4.0;
 
 /// An inlier's rays must meet within this many times the extent of the ground truth's camera
-/// centres (their largest distance, [`scene_extent`], as the correctness thresholds use): every surface of the rendered scenes, and of
-/// the photographed ones, lies well within it, and rays that are parallel up to noise meet
-/// hundreds of extents away, or behind.
+/// centres (their largest distance, [`scene_extent`], as the correctness thresholds use): every
+/// surface of the rendered scenes, and of the photographed ones, lies well within it, and rays
+/// that are parallel up to noise meet hundreds of extents away, or behind.
 pub const MAX_DEPTH_EXTENTS: f64 = 3.0;
 
 /// The cameras of a COLMAP text model (`cameras.txt`) as the geometry's camera models, by camera
