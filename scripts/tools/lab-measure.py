@@ -2,7 +2,7 @@
 """Measurements on a lab photo set without published ground truth (docs/priors.md).
 
 usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
-           [--run PRESET:VARIANT[:ORDER] ...]
+           [--run PRESET:VARIANT[:ORDER[:MAPPER]] ...]
 
   NAME      the set's name in the output
   IMAGES    its image folder (file names sort in capture order)
@@ -12,22 +12,30 @@ usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [
   --orbit   the capture is a closed orbit (Cup): the sanity check asks the orbit to close
   --window  the sequential graph's reach in frames [3]; more bridges the jumps of a capture that
             is only roughly a sequence (Oats, Cereal), at the risk of a false pair in it
-  --run     a prune + `colmap mapper` run to score, e.g. paper-disambiguation:order or
-            paper-disambiguation:shuffled:graph (preset, variant, --order; default image_id)
+  --run     a prune + mapper run to score, e.g. paper-disambiguation:order or
+            disambiguation:order:image_id:global (preset, variant, --order (default image_id),
+            mapper: colmap3.8 (`colmap mapper`, the default) or global (COLMAP 4.2's))
 
 Steps:
 1. Pseudo ground truth: a copy of ORDER.db keeping only pairs at most 3 frames apart in file-name
-   order, reconstructed by `colmap mapper`. Sanity check: one model with every image; the camera
-   path has no jump (largest step <= 5 median steps); with --orbit the path turns once round its
-   centroid (300 to 420 degrees; a fold that merges the two sides of an object turns about twice
-   as far) and its first and last cameras are at most 5 median steps apart. `trusted` in
-   truth.json says whether the check passed.
+   order, reconstructed by `colmap mapper` (COLMAP 3.8) and by COLMAP 4.2's global mapper
+   (pycolmap, scripts/ci/pycolmap-venv.sh). The truth is 3.8's model when it is one model with
+   every image, else the global mapper's when that one is. Sanity check: one model with every
+   image; the camera path has no jump (largest step <= 5 median steps); with --orbit the path
+   turns once round its centroid (300 to 420 degrees; a fold that merges the two sides of an
+   object turns about twice as far) and its first and last cameras are at most 5 median steps
+   apart; and the other mapper places every image it registers where the truth does (within 5%
+   of the extent and 5 degrees): two mappers that solve the same pairs differently and agree are
+   evidence, one alone is not. Images they place differently are `uncertain` in truth.json and
+   left out of `correct_agreed`; `trusted` says whether the whole check passed.
 2. Pair labels per database: `vgsel-colmap eval --labels` under the pseudo ground truth (median
-   Sampson error of the inliers >= 4 px: false).
+   Sampson error of the inliers >= 4 px: false; a pair with an uncertain image is labelled all the
+   same, so read a set's AUCs with its `uncertain` list).
 3. Per-prior AUCs: `prune --dry_run --scores` (disambiguation preset, every prior computed; and
    the paper-disambiguation preset's cost) joined with the labels by `vgsel-colmap separation`.
-4. Each --run: prune a copy, `colmap mapper`, `vgsel-colmap eval` against the pseudo ground truth
-   with the pair counts against the unpruned database.
+4. Each --run: prune a copy, map it (COLMAP 3.8 or 4.2 global), `vgsel-colmap eval` against the
+   pseudo ground truth with the pair counts against the unpruned database; `correct_agreed`
+   counts the correct cameras among the images that are not uncertain.
 Writes WORK/results.json; prints it.
 """
 import json
@@ -72,6 +80,23 @@ def mapper(db, images, out):
     log(f"colmap mapper {db}")
     run(["colmap", "mapper", "--database_path", db, "--image_path", images, "--output_path", out,
          "--Mapper.extract_colors", "0"], out + ".log")
+    open(out + ".done", "w").close()
+
+
+def global_mapper(db, images, out):
+    """COLMAP 4.2's global mapper into out/0, out/1, ... (text), on a copy of db (COLMAP 4
+    migrates a database it opens), unless done before."""
+    if os.path.exists(out + ".done"):
+        return
+    py = subprocess.run(["bash", os.path.join(ROOT, "scripts", "ci", "pycolmap-venv.sh")],
+                        capture_output=True, text=True, check=True).stdout.strip()
+    shutil.rmtree(out, ignore_errors=True)
+    copy = out + ".db"
+    shutil.copyfile(db, copy)
+    log(f"COLMAP 4.2 global mapper {db}")
+    run([py, os.path.join(ROOT, "scripts", "ci", "colmap4.py"), "map", "global", copy, images,
+         out], out + ".log")
+    os.remove(copy)
     open(out + ".done", "w").close()
 
 
@@ -124,6 +149,14 @@ def sweep_deg(points):
                             for a, b in zip(rel, rel[1:])))
 
 
+def complete(sparse, total):
+    """Whether a mapper's output is one model with all `total` images."""
+    models = [d for d in os.listdir(sparse) if d.isdigit()]
+    if len(models) != 1:
+        return False
+    return json.loads(run([VGSEL, "eval", "--model", sparse]))["registered"] == total
+
+
 def truth(images, order_db, work, orbit):
     path = os.path.join(work, "truth.json")
     if os.path.exists(path):
@@ -133,26 +166,43 @@ def truth(images, order_db, work, orbit):
         sequential_copy(order_db, seq_db)
     sparse = os.path.join(work, "sequential")
     mapper(seq_db, images, sparse)
-    models = sorted(d for d in os.listdir(sparse) if d.isdigit())
-    txt = os.path.join(work, "truth_txt")
-    os.makedirs(txt, exist_ok=True)
-    run(["colmap", "model_converter", "--input_path", os.path.join(sparse, "0"),
-         "--output_path", txt, "--output_type", "TXT"])
+    glob = os.path.join(work, "sequential_global")
+    global_mapper(seq_db, images, glob)
     total = len(os.listdir(images))
+    # 3.8's model unless only the global mapper's is whole; the other one is the check.
+    source, other = "colmap3.8", glob
+    if not complete(sparse, total) and complete(glob, total):
+        source, other = "global4.2", sparse
+    txt = os.path.join(work, "truth_txt")
+    shutil.rmtree(txt, ignore_errors=True)
+    if source == "colmap3.8":
+        os.makedirs(txt)
+        run(["colmap", "model_converter", "--input_path", os.path.join(sparse, "0"),
+             "--output_path", txt, "--output_type", "TXT"])
+    else:
+        shutil.copytree(os.path.join(glob, "0"), txt)
+    models = sorted(d for d in os.listdir(sparse if source == "colmap3.8" else glob)
+                    if d.isdigit())
     c = centres(txt)
     seq = sorted(c, key=natural)
     dist = lambda a, b: math.dist(c[a], c[b])
     steps = sorted(dist(a, b) for a, b in zip(seq, seq[1:]))
     median = steps[len(steps) // 2]
-    result = {"models": len(models), "registered": len(c), "images": total,
+    check = json.loads(run([VGSEL, "eval", "--model", other, "--ground_truth", txt]))
+    placed = {i["name"]: i["correct"] for i in check["images"]}
+    result = {"source": source, "models": len(models), "registered": len(c), "images": total,
               "largest_step_over_median": steps[-1] / median,
               "first_last_over_median": dist(seq[0], seq[-1]) / median,
-              "sweep_deg": sweep_deg([c[n] for n in seq])}
-    # A fold or a wrong link shows as a jump; an orbit must come back to its start.
+              "sweep_deg": sweep_deg([c[n] for n in seq]),
+              "other_mapper_registered": len(placed),
+              "uncertain": sorted((n for n, ok in placed.items() if not ok), key=natural)}
+    # A fold or a wrong link shows as a jump; an orbit must come back to its start; the other
+    # mapper must not place an image elsewhere.
     result["trusted"] = (len(models) == 1 and len(c) == total
                          and result["largest_step_over_median"] <= 5
                          and (not orbit or (300 <= abs(result["sweep_deg"]) <= 420
-                                            and result["first_last_over_median"] <= 5)))
+                                            and result["first_last_over_median"] <= 5))
+                         and not result["uncertain"])
     json.dump(result, open(path, "w"), indent=1)
     return result
 
@@ -189,9 +239,10 @@ def aucs(db, work, variant):
 
 
 def scored_run(images, work, dbs, spec):
-    preset, variant, *order = spec.split(":")
-    order = order[0] if order else "image_id"
-    tag = f"{preset}_{variant}_{order}"
+    preset, variant, *rest = spec.split(":")
+    order = rest[0] if rest else "image_id"
+    kind = rest[1] if len(rest) > 1 else "colmap3.8"
+    tag = f"{preset}_{variant}_{order}" + ("_global" if kind == "global" else "")
     path = os.path.join(work, f"run_{tag}.json")
     if os.path.exists(path):
         return json.load(open(path))
@@ -202,15 +253,19 @@ def scored_run(images, work, dbs, spec):
         run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
              "--preset", preset, "--order", order, "--report", report])
     sparse = os.path.join(work, f"sparse_{tag}")
-    mapper(pruned, images, sparse)
+    (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
     txt = os.path.join(work, "truth_txt")
     e = json.loads(run([VGSEL, "eval", "--model", sparse, "--ground_truth", txt,
                         "--database_path", pruned, "--baseline", db]))
     r = json.load(open(report))
-    result = {"preset": preset, "variant": variant, "order": order, "flow": r["flow"],
+    uncertain = set(json.load(open(os.path.join(work, "truth.json")))["uncertain"])
+    agreed = [i for i in e["images"] if i["name"] not in uncertain]
+    result = {"preset": preset, "variant": variant, "order": order, "mapper": kind,
+              "flow": r["flow"],
               "pairs_total": r["pairs_total"], "pairs_selected": r["pairs_selected"],
               "within_5": r["order"]["selected_within_window"],
               "models": e["models"], "registered": e["registered"], "correct": e["correct"],
+              "correct_agreed": sum(i["correct"] for i in agreed),
               "images": e["images_ground_truth"], "false_kept": e["pairs"]["false"],
               "false_total": e["pairs"]["baseline"]["false"]}
     json.dump(result, open(path, "w"), indent=1)
