@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""Whether a model keeps two look-alike copies apart: the written-down ghost check for Oats.
+
+usage: scripts/tools/two-copies.py MODEL FIRST LAST
+
+  MODEL  a COLMAP model folder (binary or text); a mapper's output folder with sub-models 0, 1,
+         ... is read sub-model by sub-model
+  FIRST  images whose names sort up to this one (natural order) see only the first copy
+  LAST   images whose names sort from this one on see only the second copy
+
+Oats (docs/priors.md) is two identical cans a capture walks between: frames 0-7 see only the
+first, 14-22 only the second (`two-copies.py MODEL 0007.png 0014.png`). A ghosted model puts both
+groups of cameras round one can: the groups then share 3D points, or their point clouds overlap.
+A model that keeps the copies apart has two clouds that share (almost) no point and lie apart,
+and it must also keep one scale: a model whose link between the groups fixes no scale shrinks
+one of them, and its cloud with it. Printed per sub-model with both groups: shared points, the
+clouds' distance in spreads (median distance of a cloud's points to its median point, the
+larger of the two), the ratio of the two spreads, and the verdict: apart when shared <= 5% of
+the smaller cloud, the distance exceeds 3 spreads and the spreads are within 3x of each other.
+That last bound is loose on purpose: Oats's second group sees a long box besides its can, so
+its cloud is 1.1-2.0x as spread in every model measured but one, and 4.8x in that one, whose
+top view shows the first group shrunk (docs/priors.md, session 9).
+"""
+import math
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+
+def natural(name):
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
+
+
+def read_text(folder):
+    """(cameras: name -> (centre, point ids), points: id -> xyz) of a text model."""
+    lines = [l for l in open(os.path.join(folder, "images.txt")) if not l.startswith("#")]
+    cams = {}
+    for head, obs in zip(lines[::2], lines[1::2]):
+        t = head.split()
+        qw, qx, qy, qz, tx, ty, tz = map(float, t[1:8])
+        r = [[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+             [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+             [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]]
+        centre = [-sum(r[i][j] * (tx, ty, tz)[i] for i in range(3)) for j in range(3)]
+        o = obs.split()
+        ids = {int(o[k + 2]) for k in range(0, len(o), 3) if int(o[k + 2]) != -1}
+        cams[" ".join(t[9:])] = (centre, ids)
+    points = {}
+    for line in open(os.path.join(folder, "points3D.txt")):
+        if not line.startswith("#") and line.strip():
+            t = line.split()
+            points[int(t[0])] = [float(v) for v in t[1:4]]
+    return cams, points
+
+
+def read(folder):
+    if os.path.exists(os.path.join(folder, "images.txt")):
+        return read_text(folder)
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run(["colmap", "model_converter", "--input_path", folder, "--output_path", tmp,
+                        "--output_type", "TXT"], check=True, capture_output=True)
+        return read_text(tmp)
+
+
+def cloud(points, ids):
+    """Median point and median distance to it (the spread) of some 3D points."""
+    xyz = [points[i] for i in ids if i in points]
+    centre = [statistics.median(p[k] for p in xyz) for k in range(3)]
+    return centre, statistics.median(math.dist(p, centre) for p in xyz)
+
+
+def judge(cams, points, first, last):
+    a = [n for n in cams if natural(n) <= natural(first)]
+    b = [n for n in cams if natural(n) >= natural(last)]
+    if not a or not b:
+        return None
+    pa = set().union(*(cams[n][1] for n in a))
+    pb = set().union(*(cams[n][1] for n in b))
+    shared = len(pa & pb)
+    (ca, sa), (cb, sb) = cloud(points, pa - pb), cloud(points, pb - pa)
+    spread = max(sa, sb)
+    apart = math.dist(ca, cb) / spread
+    scale = max(sa, sb) / min(sa, sb)
+    ok = shared <= 0.05 * min(len(pa), len(pb)) and apart > 3 and scale <= 3
+    return (f"first {len(a)} cameras / {len(pa)} points, last {len(b)} / {len(pb)}, "
+            f"shared {shared}, apart {apart:.1f} spreads, spreads {scale:.1f}x: "
+            f"{'apart' if ok else 'NOT apart'}")
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.exit(__doc__)
+    model, first, last = argv
+    subs = sorted((d for d in os.listdir(model) if d.isdigit()), key=int)
+    for sub in subs or [None]:
+        cams, points = read(os.path.join(model, sub) if sub else model)
+        verdict = judge(cams, points, first, last)
+        print(f"{sub or '.'}: {len(cams)} images, "
+              + (verdict or "not both groups (nothing to merge)"))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
