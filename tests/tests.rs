@@ -25,4 +25,5 @@ mod solver;
 mod stray_files;
 mod synth;
 mod track_criterion;
+mod two_copies;
 mod ux;

@@ -16,7 +16,8 @@ and it must also keep one scale: a model whose link between the groups fixes no 
 one of them, and its cloud with it. Printed per sub-model with both groups: shared points, the
 clouds' distance in spreads (median distance of a cloud's points to its median point, the
 larger of the two), the ratio of the two spreads, and the verdict: apart when shared <= 5% of
-the smaller cloud, the distance exceeds 3 spreads and the spreads are within 3x of each other.
+the smaller cloud, the distance exceeds 3 spreads and the spreads are within 3x of each other
+(a group that sees no point of its own is not apart).
 That last bound is loose on purpose: Oats's second group sees a long box besides its can, so
 its cloud is 1.1-2.0x as spread in every model measured but one, and 4.8x in that one, whose
 top view shows the first group shrunk (docs/priors.md, session 9).
@@ -80,6 +81,9 @@ def judge(cams, points, first, last):
     pa = set().union(*(cams[n][1] for n in a))
     pb = set().union(*(cams[n][1] for n in b))
     shared = len(pa & pb)
+    if not pa - pb or not pb - pa:
+        return (f"first {len(a)} cameras / {len(pa)} points, last {len(b)} / {len(pb)}, "
+                f"shared {shared}, a group sees no point of its own: NOT apart")
     (ca, sa), (cb, sb) = cloud(points, pa - pb), cloud(points, pb - pa)
     spread = max(sa, sb)
     apart = math.dist(ca, cb) / spread
