@@ -6,8 +6,11 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Command;
 
+/// A 3D point of a model: its id and position.
+type Point = (u32, [f64; 3]);
+
 /// Points on a ring of `radius` round `centre` (in the x-z plane), with ids from `first_id`.
-fn ring(centre: [f64; 3], radius: f64, first_id: u32) -> Vec<(u32, [f64; 3])> {
+fn ring(centre: [f64; 3], radius: f64, first_id: u32) -> Vec<Point> {
     (0..40)
         .map(|k| {
             let a = k as f64 * std::f64::consts::TAU / 40.0;
@@ -23,10 +26,10 @@ fn ring(centre: [f64; 3], radius: f64, first_id: u32) -> Vec<(u32, [f64; 3])> {
 
 /// A text model: images 0000.png..0007.png at x = 0..7 see `first`, 0014.png..0022.png at
 /// x = 20..28 see `second`, unless it is empty (identity rotations: the centre is -t).
-fn write_model(dir: &Path, first: &[(u32, [f64; 3])], second: &[(u32, [f64; 3])]) {
+fn write_model(dir: &Path, first: &[Point], second: &[Point]) {
     let mut images = String::new();
     let mut id = 1;
-    let groups: [(std::ops::RangeInclusive<u32>, f64, &[(u32, [f64; 3])]); 2] =
+    let groups: [(std::ops::RangeInclusive<u32>, f64, &[Point]); 2] =
         [(0..=7, 0.0, first), (14..=22, 6.0, second)];
     for (frames, x0, seen) in groups {
         if seen.is_empty() {
@@ -83,7 +86,7 @@ fn run(dir: &Path) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-fn verdict(first: &[(u32, [f64; 3])], second: &[(u32, [f64; 3])]) -> String {
+fn verdict(first: &[Point], second: &[Point]) -> String {
     let dir = tempfile::tempdir().unwrap();
     write_model(dir.path(), first, second);
     run(dir.path())
