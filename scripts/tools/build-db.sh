@@ -10,6 +10,11 @@
 #   OUT.db  written once: an existing OUT.db with OUT.db.done next to it is kept as it is
 #   SEED    shuffle the image ids with this seed (none: ids in file-name order, as COLMAP does)
 # environment: MAX_FEATURES [2000]
+#   ASPECT=W:H  the images were stretched from this aspect ratio: they are resampled to it first
+#   (same height, pycolmap's bilinear rescale) into OUT.images/, the folder to map them from. The
+#   yan2017 GIF frames (Street, Books, Oats, Cereal: 840x526, stretched from 4:3 photographs)
+#   need ASPECT=4:3: with the stretch, one focal length cannot fit them (a PINHOLE camera on
+#   Books' frames converges to fx/fy = 1.197, the stretch's 1.198; docs/priors.md).
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES OUT.db [SEED]" >&2; exit 2; }
 images=$(cd "$1" && pwd)
@@ -18,6 +23,23 @@ seed=${3:-}
 [ -f "$out.done" ] && { echo "build-db: $out exists" >&2; exit 0; }
 rm -f "$out"
 mkdir -p "$(dirname "$out")"
+if [ -n "${ASPECT:-}" ]; then
+  py=$(bash "$(dirname "$0")/../ci/pycolmap-venv.sh")
+  rm -rf "$out.images"
+  mkdir -p "$out.images"
+  echo "build-db: resampling to $ASPECT -> $out.images" >&2
+  "$py" - "$images" "$out.images" "$ASPECT" <<'PY'
+import os, sys
+import pycolmap
+src, dst, aspect = sys.argv[1], sys.argv[2], sys.argv[3]
+w, h = (int(v) for v in aspect.split(":"))
+for name in sorted(os.listdir(src)):
+    bitmap = pycolmap.Bitmap.read(os.path.join(src, name), True)
+    bitmap.rescale(round(bitmap.height * w / h), bitmap.height)
+    bitmap.write(os.path.join(dst, name))
+PY
+  images=$(cd "$out.images" && pwd)
+fi
 src=$images
 links=
 if [ -n "$seed" ]; then
