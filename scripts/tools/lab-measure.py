@@ -24,10 +24,11 @@ Steps:
    image; the camera path has no jump (largest step <= 5 median steps); with --orbit the path
    turns once round its centroid (300 to 420 degrees; a fold that merges the two sides of an
    object turns about twice as far) and its first and last cameras are at most 5 median steps
-   apart; and the other mapper places every image it registers where the truth does (within 5%
-   of the extent and 5 degrees): two mappers that solve the same pairs differently and agree are
-   evidence, one alone is not. Images they place differently are `uncertain` in truth.json and
-   left out of `correct_agreed`; `trusted` says whether the whole check passed.
+   apart; and the other mapper registers every image and places it where the truth does (within
+   5% of the extent and 5 degrees): two mappers that solve the same pairs differently and agree
+   are evidence, one alone is not. Images it places differently or does not register are
+   `uncertain` in truth.json and left out of `correct_agreed`; `trusted` says whether the whole
+   check passed.
 2. Pair labels per database: `vgsel-colmap eval --labels` under the pseudo ground truth (median
    Sampson error of the inliers >= 4 px: false; a pair with an uncertain image is labelled all the
    same, so read a set's AUCs with its `uncertain` list).
@@ -190,12 +191,13 @@ def truth(images, order_db, work, orbit):
     median = steps[len(steps) // 2]
     check = json.loads(run([VGSEL, "eval", "--model", other, "--ground_truth", txt]))
     placed = {i["name"]: i["correct"] for i in check["images"]}
+    # An image the other mapper did not register is unconfirmed: as uncertain as a moved one.
     result = {"source": source, "models": len(models), "registered": len(c), "images": total,
               "largest_step_over_median": steps[-1] / median,
               "first_last_over_median": dist(seq[0], seq[-1]) / median,
               "sweep_deg": sweep_deg([c[n] for n in seq]),
               "other_mapper_registered": len(placed),
-              "uncertain": sorted((n for n, ok in placed.items() if not ok), key=natural)}
+              "uncertain": sorted((n for n in c if not placed.get(n)), key=natural)}
     # A fold or a wrong link shows as a jump; an orbit must come back to its start; the other
     # mapper must not place an image elsewhere.
     result["trusted"] = (len(models) == 1 and len(c) == total
