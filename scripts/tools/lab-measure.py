@@ -5,7 +5,8 @@ usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [
            [--run PRESET:VARIANT[:ORDER[:MAPPER]] ...]
 
   NAME      the set's name in the output
-  IMAGES    its image folder (file names sort in capture order)
+  IMAGES    its image folder (file names sort in capture order; for the stretched yan2017 frames
+            the square-pixel copy that `ASPECT=4:3 scripts/tools/build-db.sh` makes)
   WORK      output folder; every step is skipped when its output exists (delete to redo)
   ORDER.db  the set's database with image ids in capture order (scripts/tools/build-db.sh)
   VARIANT=DB  more databases of the same images, e.g. shuffled=shuffled1.db (ids in random order)
@@ -171,9 +172,9 @@ def truth(images, order_db, work, orbit):
     global_mapper(seq_db, images, glob)
     total = len(os.listdir(images))
     # 3.8's model unless only the global mapper's is whole; the other one is the check.
-    source, other = "colmap3.8", glob
+    source, chosen, other = "colmap3.8", sparse, glob
     if not complete(sparse, total) and complete(glob, total):
-        source, other = "global4.2", sparse
+        source, chosen, other = "global4.2", glob, sparse
     txt = os.path.join(work, "truth_txt")
     shutil.rmtree(txt, ignore_errors=True)
     if source == "colmap3.8":
@@ -182,8 +183,7 @@ def truth(images, order_db, work, orbit):
              "--output_path", txt, "--output_type", "TXT"])
     else:
         shutil.copytree(os.path.join(glob, "0"), txt)
-    models = sorted(d for d in os.listdir(sparse if source == "colmap3.8" else glob)
-                    if d.isdigit())
+    models = [d for d in os.listdir(chosen) if d.isdigit()]
     c = centres(txt)
     seq = sorted(c, key=natural)
     dist = lambda a, b: math.dist(c[a], c[b])
@@ -199,7 +199,7 @@ def truth(images, order_db, work, orbit):
               "other_mapper_registered": len(placed),
               "uncertain": sorted((n for n in c if not placed.get(n)), key=natural)}
     # A fold or a wrong link shows as a jump; an orbit must come back to its start; the other
-    # mapper must not place an image elsewhere.
+    # mapper must confirm every image.
     result["trusted"] = (len(models) == 1 and len(c) == total
                          and result["largest_step_over_median"] <= 5
                          and (not orbit or (300 <= abs(result["sweep_deg"]) <= 420
