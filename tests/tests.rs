@@ -21,6 +21,7 @@ mod reliability;
 mod rewrite;
 mod search;
 mod separation;
+mod sequence_pairs;
 mod solver;
 mod stray_files;
 mod synth;
