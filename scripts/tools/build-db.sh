@@ -11,7 +11,7 @@
 #   SEED    shuffle the image ids with this seed (none: ids in file-name order, as COLMAP does)
 # environment: MAX_FEATURES [2000]
 #   ASPECT=W:H  the images were stretched from this aspect ratio: they are resampled to it first
-#   (same height, pycolmap's bilinear rescale) into OUT.images/, the folder to map them from. The
+#   (same height, scripts/tools/unstretch.py) into OUT.images/, the folder to map them from. The
 #   yan2017 GIF frames (Street, Books, Oats, Cereal: 840x526, stretched from 4:3 photographs)
 #   need ASPECT=4:3: with the stretch, one focal length cannot fit them (a PINHOLE camera on
 #   Books' frames converges to fx/fy = 1.197, the stretch's 1.198; docs/priors.md).
@@ -28,16 +28,7 @@ if [ -n "${ASPECT:-}" ]; then
   rm -rf "$out.images"
   mkdir -p "$out.images"
   echo "build-db: resampling to $ASPECT -> $out.images" >&2
-  "$py" - "$images" "$out.images" "$ASPECT" <<'PY'
-import os, sys
-import pycolmap
-src, dst, aspect = sys.argv[1], sys.argv[2], sys.argv[3]
-w, h = (int(v) for v in aspect.split(":"))
-for name in sorted(os.listdir(src)):
-    bitmap = pycolmap.Bitmap.read(os.path.join(src, name), True)
-    bitmap.rescale(round(bitmap.height * w / h), bitmap.height)
-    bitmap.write(os.path.join(dst, name))
-PY
+  "$py" "$(dirname "$0")/unstretch.py" "$images" "$out.images" "$ASPECT"
   images=$(cd "$out.images" && pwd)
 fi
 src=$images
