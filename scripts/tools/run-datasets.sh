@@ -7,6 +7,8 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 datasets=${DATASETS:-$here/../shared/datasets}
 work=${WORK:-$here/target/datasets}
+# pycolmap resamples the stretched sets; numpy (a pycolmap dependency) draws the top views.
+py=$(bash "$here/scripts/ci/pycolmap-venv.sh")
 sets=("$@")
 [ ${#sets[@]} -gt 0 ] || sets=(strecha_fountain-P11 lund_door yan2017_street_gifframes
   yan2017_books_gifframes yan2017_oats_gifframes yan2017_cereal_gifframes)
@@ -17,7 +19,6 @@ for set in "${sets[@]}"; do
   images=$datasets/$set/images
   if [[ $set == yan2017_*_gifframes ]]; then
     # 4:3 photographs stretched to 840x526: back to square pixels first (docs/priors.md).
-    py=$(bash "$here/scripts/ci/pycolmap-venv.sh")
     [ -d "$work/$set.images" ] || "$py" "$here/scripts/tools/unstretch.py" "$images" "$work/$set.images" 4:3
     images=$work/$set.images
   fi
@@ -28,5 +29,5 @@ python3 "$here/scripts/tools/results-table.py" "$work" "${sets[@]}"
 # Sets without ground truth: the written-down ghost check on the camera paths (scripts/tools/topview.py).
 for set in "${sets[@]}"; do
   [ -f "$datasets/$set/gt/colmap_text/images.txt" ] || [ ! -f "$work/$set/summary.json" ] && continue
-  python3 "$here/scripts/tools/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"
+  "$py" "$here/scripts/tools/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"
 done
