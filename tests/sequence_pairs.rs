@@ -2,26 +2,12 @@
 //! order, on the fixture database with its images renamed so that natural name order, plain
 //! string order and id order all differ.
 
-use crate::support::{exec, fixture, Schema};
+use crate::support::{exec, fixture, python_tool, Schema};
 use std::path::Path;
-use std::process::Command;
 
 /// The script's output lines for `db`.
 fn run(db: &Path, args: &[&str]) -> Vec<String> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/tools/sequence-pairs.py");
-    let out = Command::new("python3")
-        .arg(script)
-        .arg(db)
-        .args(args)
-        .output()
-        .expect("python3 runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout)
-        .unwrap()
+    python_tool("scripts/tools/sequence-pairs.py", db, args)
         .lines()
         .map(str::to_string)
         .collect()

@@ -2,9 +2,9 @@
 //! built here: two groups of cameras, each round its own cluster of points. The verdict must be
 //! "apart" only when the clusters share no point, lie apart and keep one scale.
 
+use crate::support::python_tool;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::Command;
 
 /// A 3D point of a model: its id and position.
 type Point = (u32, [f64; 3]);
@@ -69,27 +69,14 @@ fn write_model(dir: &Path, first: &[Point], second: &[Point]) {
     .unwrap();
 }
 
-/// What the script prints for a model folder.
-fn run(dir: &Path) -> String {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/tools/two-copies.py");
-    let out = Command::new("python3")
-        .arg(script)
-        .arg(dir)
-        .args(["0007.png", "0014.png"])
-        .output()
-        .expect("python3 runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
 fn verdict(first: &[Point], second: &[Point]) -> String {
     let dir = tempfile::tempdir().unwrap();
     write_model(dir.path(), first, second);
-    run(dir.path())
+    python_tool(
+        "scripts/tools/two-copies.py",
+        dir.path(),
+        &["0007.png", "0014.png"],
+    )
 }
 
 /// Asserts that the script's output for the two groups contains every one of `expected`.
