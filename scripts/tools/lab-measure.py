@@ -38,8 +38,10 @@ Steps:
 4. Each --run: prune a copy, map it (COLMAP 3.8 or 4.2 global), `vgsel-colmap eval` against the
    pseudo ground truth with the pair counts against the unpruned database; `correct_agreed`
    counts the correct cameras among the images that are not uncertain.
-Writes WORK/results.json; prints it.
+Writes WORK/results.json; prints it. Every step is skipped when its output exists, so a WORK
+folder keeps to the inputs that made it (WORK/inputs.json; other inputs stop with an error).
 """
+import hashlib
 import json
 import math
 import os
@@ -274,6 +276,36 @@ def scored_run(images, work, dbs, spec):
     return result
 
 
+def check_inputs(work, images, dbs, orbit):
+    """WORK's steps are skipped when their outputs exist, so WORK must keep to the inputs that made
+    them: the first run records them (databases by content hash, images by name and size, the
+    window and --orbit) in WORK/inputs.json, a later run with other inputs stops with an error.
+    A variant database given for the first time is added."""
+    path = os.path.join(work, "inputs.json")
+    def digest(db):
+        h = hashlib.sha256()
+        with open(db, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        return h.hexdigest()
+    now = {"images": sorted([n, os.path.getsize(os.path.join(images, n))]
+                            for n in os.listdir(images)),
+           "window": WINDOW, "orbit": orbit,
+           "databases": {v: digest(db) for v, db in dbs.items()}}
+    if os.path.exists(path):
+        before = json.load(open(path))
+        for key in ("images", "window", "orbit"):
+            if before[key] != now[key]:
+                sys.exit(f"lab-measure: {work} was made with other {key}: use another WORK folder "
+                         "or delete it")
+        for v, h in now["databases"].items():
+            if before["databases"].get(v, h) != h:
+                sys.exit(f"lab-measure: {work} was made from another `{v}` database: use another "
+                         "WORK folder or delete it")
+        now["databases"] = {**before["databases"], **now["databases"]}
+    json.dump(now, open(path, "w"), indent=1)
+
+
 def main(argv):
     global WINDOW
     orbit = "--orbit" in argv
@@ -289,6 +321,7 @@ def main(argv):
     name, images, work, order_db, *more = argv
     os.makedirs(work, exist_ok=True)
     dbs = {"order": order_db, **dict(m.split("=", 1) for m in more)}
+    check_inputs(work, images, dbs, orbit)
     result = {"set": name, "truth": truth(images, order_db, work, orbit)}
     result["auc"] = {v: aucs(db, work, v) for v, db in dbs.items()}
     result["runs"] = [scored_run(images, work, dbs, spec) for spec in runs]
