@@ -41,6 +41,7 @@ Steps:
 Writes WORK/results.json; prints it. Every step is skipped when its output exists, so a WORK
 folder keeps to the inputs that made it (WORK/inputs.json; other inputs stop with an error).
 """
+import functools
 import hashlib
 import json
 import math
@@ -50,6 +51,8 @@ import shutil
 import sqlite3
 import subprocess
 import sys
+
+from colmap_files import name_ranks, natural, read_images
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -71,10 +74,6 @@ def run(cmd, logfile=None):
     return out.stdout
 
 
-def natural(name):
-    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
-
-
 def mapper(db, images, out):
     """`colmap mapper` into out/ (sub-models out/0, out/1, ...), unless done before."""
     if os.path.exists(out + ".done"):
@@ -87,19 +86,24 @@ def mapper(db, images, out):
     open(out + ".done", "w").close()
 
 
+@functools.lru_cache(maxsize=None)
+def pycolmap_python():
+    """The python of scripts/ci/pycolmap-venv.sh (created on first use)."""
+    return subprocess.run(["bash", os.path.join(ROOT, "scripts", "ci", "pycolmap-venv.sh")],
+                          capture_output=True, text=True, check=True).stdout.strip()
+
+
 def global_mapper(db, images, out):
     """COLMAP 4.2's global mapper into out/0, out/1, ... (text), on a copy of db (COLMAP 4
     migrates a database it opens), unless done before."""
     if os.path.exists(out + ".done"):
         return
-    py = subprocess.run(["bash", os.path.join(ROOT, "scripts", "ci", "pycolmap-venv.sh")],
-                        capture_output=True, text=True, check=True).stdout.strip()
     shutil.rmtree(out, ignore_errors=True)
     copy = out + ".db"
     shutil.copyfile(db, copy)
     log(f"COLMAP 4.2 global mapper {db}")
-    run([py, os.path.join(ROOT, "scripts", "ci", "colmap4.py"), "map", "global", copy, images,
-         out], out + ".log")
+    run([pycolmap_python(), os.path.join(ROOT, "scripts", "ci", "colmap4.py"), "map", "global",
+         copy, images, out], out + ".log")
     os.remove(copy)
     open(out + ".done", "w").close()
 
@@ -109,8 +113,7 @@ def sequential_copy(db, out):
     tmp = out + ".tmp"
     shutil.copyfile(db, tmp)
     con = sqlite3.connect(tmp)
-    names = dict(con.execute("SELECT image_id, name FROM images"))
-    rank = {i: k for k, i in enumerate(sorted(names, key=lambda i: natural(names[i])))}
+    rank = name_ranks(con)
     far = []
     for (pid,) in con.execute("SELECT pair_id FROM two_view_geometries"):
         a, b = divmod(pid, 2147483647)
@@ -120,21 +123,6 @@ def sequential_copy(db, out):
     con.commit()
     con.close()
     os.replace(tmp, out)
-
-
-def centres(model_txt):
-    """name -> camera centre of a COLMAP text model."""
-    out = {}
-    lines = [l for l in open(os.path.join(model_txt, "images.txt")) if not l.startswith("#")]
-    for line in lines[::2]:
-        t = line.split()
-        qw, qx, qy, qz, tx, ty, tz = map(float, t[1:8])
-        # R^T t with R from the quaternion (world to camera); centre = -R^T t.
-        r = [[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
-             [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
-             [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]]
-        out[" ".join(t[9:])] = [-sum(r[i][j] * (tx, ty, tz)[i] for i in range(3)) for j in range(3)]
-    return out
 
 
 def sweep_deg(points):
@@ -186,7 +174,7 @@ def truth(images, order_db, work, orbit):
     else:
         shutil.copytree(os.path.join(glob, "0"), txt)
     models = [d for d in os.listdir(chosen) if d.isdigit()]
-    c = centres(txt)
+    c = {name: centre for name, (centre, _) in read_images(txt).items()}
     seq = sorted(c, key=natural)
     dist = lambda a, b: math.dist(c[a], c[b])
     steps = sorted(dist(a, b) for a, b in zip(seq, seq[1:]))

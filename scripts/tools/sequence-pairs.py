@@ -19,13 +19,10 @@ frames in place with the global mapper; Street, Books, Cup and the rendered symm
 without it. With W = 5 Oats folds: a reach that takes in images across a walk between two
 look-alike objects takes in false pairs, so keep W to the neighbours that surely overlap.
 """
-import re
 import sqlite3
 import sys
 
-
-def natural(name):
-    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
+from colmap_files import name_ranks
 
 
 def main(argv):
@@ -44,8 +41,7 @@ def main(argv):
     db, window = args[0], int(args[1])
     con = sqlite3.connect(f"file:{db}?mode=ro", uri=True)
     names = dict(con.execute("SELECT image_id, name FROM images"))
-    key = (lambda i: natural(names[i])) if order == "name" else (lambda i: i)
-    rank = {i: k for k, i in enumerate(sorted(names, key=key))}
+    rank = name_ranks(con) if order == "name" else {i: k for k, i in enumerate(sorted(names))}
     pairs = []
     for pair_id, rows in con.execute("SELECT pair_id, rows FROM two_view_geometries"):
         a, b = divmod(pair_id, 2147483647)

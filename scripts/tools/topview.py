@@ -16,31 +16,19 @@ Needs numpy and `colmap model_converter`.
 """
 import os
 import struct
-import subprocess
 import sys
-import tempfile
 import zlib
 
 import numpy as np
 
+from colmap_files import read_images, text_model
+
 
 def centres(model_dir):
     """Camera centres of one model, in image-name order."""
-    with tempfile.TemporaryDirectory() as tmp:
-        subprocess.run(["colmap", "model_converter", "--input_path", model_dir,
-                        "--output_path", tmp, "--output_type", "TXT"],
-                       check=True, capture_output=True)
-        lines = [l for l in open(os.path.join(tmp, "images.txt")) if not l.startswith("#")]
-    out = {}
-    for line in lines[::2]:
-        t = line.split()
-        qw, qx, qy, qz, tx, ty, tz = map(float, t[1:8])
-        r = np.array([
-            [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
-            [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
-            [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]])
-        out[" ".join(t[9:])] = -r.T @ np.array([tx, ty, tz])
-    return np.array([out[k] for k in sorted(out)])
+    with text_model(model_dir) as text:
+        images = read_images(text)
+    return np.array([images[k][0] for k in sorted(images)])
 
 
 def largest_model(sparse):

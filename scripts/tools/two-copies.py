@@ -24,46 +24,16 @@ top view shows the first group shrunk (docs/priors.md, session 9).
 """
 import math
 import os
-import re
 import statistics
-import subprocess
 import sys
-import tempfile
 
-
-def natural(name):
-    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
-
-
-def read_text(folder):
-    """(cameras: name -> (centre, point ids), points: id -> xyz) of a text model."""
-    lines = [l for l in open(os.path.join(folder, "images.txt")) if not l.startswith("#")]
-    cams = {}
-    for head, obs in zip(lines[::2], lines[1::2]):
-        t = head.split()
-        qw, qx, qy, qz, tx, ty, tz = map(float, t[1:8])
-        r = [[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
-             [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
-             [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]]
-        centre = [-sum(r[i][j] * (tx, ty, tz)[i] for i in range(3)) for j in range(3)]
-        o = obs.split()
-        ids = {int(o[k + 2]) for k in range(0, len(o), 3) if int(o[k + 2]) != -1}
-        cams[" ".join(t[9:])] = (centre, ids)
-    points = {}
-    for line in open(os.path.join(folder, "points3D.txt")):
-        if not line.startswith("#") and line.strip():
-            t = line.split()
-            points[int(t[0])] = [float(v) for v in t[1:4]]
-    return cams, points
+from colmap_files import natural, read_images, read_points, text_model
 
 
 def read(folder):
-    if os.path.exists(os.path.join(folder, "images.txt")):
-        return read_text(folder)
-    with tempfile.TemporaryDirectory() as tmp:
-        subprocess.run(["colmap", "model_converter", "--input_path", folder, "--output_path", tmp,
-                        "--output_type", "TXT"], check=True, capture_output=True)
-        return read_text(tmp)
+    """(cameras: name -> (centre, point ids), points: id -> xyz) of a model folder."""
+    with text_model(folder) as text:
+        return read_images(text), read_points(text)
 
 
 def cloud(points, ids):

@@ -1,0 +1,63 @@
+"""What the measuring scripts read from COLMAP's files, in one place: image names in capture
+order, and text models (camera centres, the 3D points each image sees, the points' positions).
+Standard library only, so that the system python runs it.
+"""
+import contextlib
+import os
+import re
+import subprocess
+import tempfile
+
+
+def natural(name):
+    """Sort key: digit runs compared as numbers (frame 9 before frame 10), as `--order name`."""
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
+
+
+def name_ranks(con):
+    """image_id -> position in natural name order, for an open COLMAP database."""
+    names = dict(con.execute("SELECT image_id, name FROM images"))
+    return {i: k for k, i in enumerate(sorted(names, key=lambda i: natural(names[i])))}
+
+
+def camera_centre(qw, qx, qy, qz, tx, ty, tz):
+    """The centre -R^T t of a camera whose world-to-camera rotation is the quaternion."""
+    r = [[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+         [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+         [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]]
+    return [-sum(r[i][j] * (tx, ty, tz)[i] for i in range(3)) for j in range(3)]
+
+
+def read_images(folder):
+    """name -> (camera centre, ids of the 3D points it sees) of a text model's images.txt."""
+    lines = [l for l in open(os.path.join(folder, "images.txt")) if not l.startswith("#")]
+    out = {}
+    for head, obs in zip(lines[::2], lines[1::2] + [""] * (len(lines) % 2)):
+        t = head.split()
+        o = obs.split()
+        ids = {int(o[k + 2]) for k in range(0, len(o), 3) if int(o[k + 2]) != -1}
+        out[" ".join(t[9:])] = (camera_centre(*map(float, t[1:8])), ids)
+    return out
+
+
+def read_points(folder):
+    """3D point id -> position, of a text model's points3D.txt."""
+    points = {}
+    for line in open(os.path.join(folder, "points3D.txt")):
+        if not line.startswith("#") and line.strip():
+            t = line.split()
+            points[int(t[0])] = [float(v) for v in t[1:4]]
+    return points
+
+
+@contextlib.contextmanager
+def text_model(folder):
+    """The folder itself when it holds a text model, else a temporary text copy of its binary
+    model (`colmap model_converter`)."""
+    if os.path.exists(os.path.join(folder, "images.txt")):
+        yield folder
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run(["colmap", "model_converter", "--input_path", folder, "--output_path", tmp,
+                        "--output_type", "TXT"], check=True, capture_output=True)
+        yield tmp
