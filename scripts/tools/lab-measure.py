@@ -2,7 +2,7 @@
 """Measurements on a lab photo set without published ground truth (docs/priors.md).
 
 usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
-           [--run PRESET:VARIANT[:ORDER[:MAPPER]] ...]
+           [--run PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]] ...]
 
   NAME      the set's name in the output
   IMAGES    its image folder (file names sort in capture order; for the stretched yan2017 frames
@@ -13,9 +13,12 @@ usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [
   --orbit   the capture is a closed orbit (Cup): the sanity check asks the orbit to close
   --window  the sequential graph's reach in frames [3]; more bridges the jumps of a capture that
             is only roughly a sequence (Oats, Cereal), at the risk of a false pair in it
-  --run     a prune + mapper run to score, e.g. paper-disambiguation:order or
-            disambiguation:order:image_id:global (preset, variant, --order (default image_id),
-            mapper: colmap3.8 (`colmap mapper`, the default) or global (COLMAP 4.2's))
+  --run     a prune + mapper run to score, PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]], e.g.
+            paper-disambiguation:order, disambiguation:order:image_id:global or
+            "disambiguation:order:name:global:--sequence_window 3 --keep_pairs near.txt"
+            (PRESET `full`: the database unpruned; --order, default image_id; mapper colmap3.8
+            (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
+            at spaces). results.json names each run's model folder (`sparse`).
 
 Steps:
 1. Pseudo ground truth: a copy of ORDER.db keeping only pairs at most 3 frames apart in file-name
@@ -231,31 +234,39 @@ def aucs(db, work, variant):
 
 
 def scored_run(images, work, dbs, spec):
-    preset, variant, *rest = spec.split(":")
+    preset, variant, *rest = spec.split(":", 4)
     order = rest[0] if rest else "image_id"
     kind = rest[1] if len(rest) > 1 else "colmap3.8"
+    extra = rest[2].split() if len(rest) > 2 else []
     tag = f"{preset}_{variant}_{order}" + ("_global" if kind == "global" else "")
+    if extra:
+        tag += "_" + hashlib.sha1(" ".join(extra).encode()).hexdigest()[:8]
     path = os.path.join(work, f"run_{tag}.json")
     if os.path.exists(path):
         return json.load(open(path))
     db = dbs[variant]
-    pruned = os.path.join(work, f"pruned_{tag}.db")
-    report = os.path.join(work, f"prune_{tag}.json")
-    if not os.path.exists(report):
-        run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
-             "--preset", preset, "--order", order, "--report", report])
+    if preset == "full":
+        pruned, r = db, None
+    else:
+        pruned = os.path.join(work, f"pruned_{tag}.db")
+        report = os.path.join(work, f"prune_{tag}.json")
+        if not os.path.exists(report):
+            run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
+                 "--preset", preset, "--order", order, "--report", report, *extra])
+        r = json.load(open(report))
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
     txt = os.path.join(work, "truth_txt")
     e = json.loads(run([VGSEL, "eval", "--model", sparse, "--ground_truth", txt,
                         "--database_path", pruned, "--baseline", db]))
-    r = json.load(open(report))
     uncertain = set(json.load(open(os.path.join(work, "truth.json")))["uncertain"])
     agreed = [i for i in e["images"] if i["name"] not in uncertain]
     result = {"preset": preset, "variant": variant, "order": order, "mapper": kind,
-              "flow": r["flow"],
-              "pairs_total": r["pairs_total"], "pairs_selected": r["pairs_selected"],
-              "within_5": r["order"]["selected_within_window"],
+              "prune_args": " ".join(extra), "sparse": sparse,
+              "flow": r and r["flow"],
+              "pairs_total": r["pairs_total"] if r else e["pairs"]["used"],
+              "pairs_selected": r["pairs_selected"] if r else e["pairs"]["used"],
+              "within_5": r and r["order"]["selected_within_window"],
               "models": e["models"], "registered": e["registered"], "correct": e["correct"],
               "correct_agreed": sum(i["correct"] for i in agreed),
               "images": e["images_ground_truth"], "false_kept": e["pairs"]["false"],

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# The paper's five lab photo sets as the README and docs/priors.md (session 9) measure them, ids
+# in capture order: each set matched by COLMAP 3.8 (build-db.sh; the yan2017 GIF frames first
+# resampled to 4:3), its reference checked by two mappers (lab-measure.py, 3-frame window), and
+# eight runs scored against it with COLMAP 3.8 and 4.2's global mapper: the full database, the
+# disambiguation preset, the paper's preset, `--sequence_window 3` (name order), and the
+# close-neighbour recipe (`--keep_pairs` the pairs within 3 frames, sequence-pairs.py). Oats is
+# also judged by two-copies.py. Prints one line per run; WORK/SET/results.json has everything.
+#
+# usage: scripts/tools/lab-sets.sh [SET ...]   (street books cup oats cereal by default)
+# environment: DATASETS (default ../shared/datasets), WORK (default target/lab-sets)
+set -euo pipefail
+here=$(cd "$(dirname "$0")/../.." && pwd)
+datasets=${DATASETS:-$here/../shared/datasets}
+work=${WORK:-$here/target/lab-sets}
+[ -x "$here/target/release/vgsel-colmap" ] || (cd "$here" && cargo build --release --quiet)
+sets=("$@")
+[ ${#sets[@]} -gt 0 ] || sets=(street books cup oats cereal)
+mkdir -p "$work"
+for set in "${sets[@]}"; do
+  if [ "$set" = cup ]; then
+    images=$datasets/cup/images
+    ASPECT= bash "$here/scripts/tools/build-db.sh" "$images" "$work/$set.db"
+    orbit=--orbit
+  else
+    ASPECT=4:3 bash "$here/scripts/tools/build-db.sh" \
+      "$datasets/yan2017_${set}_gifframes/images" "$work/$set.db"
+    images=$work/$set.db.images
+    orbit=
+  fi
+  near=$work/$set.near3.txt
+  python3 "$here/scripts/tools/sequence-pairs.py" "$work/$set.db" 3 >"$near"
+  runs=()
+  for mapper in colmap3.8 global; do
+    runs+=(--run "full:order:image_id:$mapper" --run "disambiguation:order:image_id:$mapper"
+      --run "paper-disambiguation:order:image_id:$mapper"
+      --run "disambiguation:order:name:$mapper:--sequence_window 3"
+      --run "disambiguation:order:name:$mapper:--sequence_window 3 --keep_pairs $near")
+  done
+  python3 "$here/scripts/tools/lab-measure.py" "$set" "$images" "$work/$set" "$work/$set.db" \
+    $orbit "${runs[@]}" >/dev/null
+  python3 - "$work/$set/results.json" "$set" <<'PY' | while IFS=$'\t' read -r line sparse; do
+import json, os, sys
+r = json.load(open(sys.argv[1]))
+t = r["truth"]
+print(f"{sys.argv[2]}: reference from {t['source']}, trusted {t['trusted']}, "
+      f"uncertain {len(t['uncertain'])} of {t['images']}\t")
+for x in r["runs"]:
+    what = " ".join([x["preset"], *map(os.path.basename, x["prune_args"].split())])
+    print(f"  {what:<62} {x['mapper']:<9} pairs {x['pairs_selected']:>4}  models {x['models']}  "
+          f"registered {x['registered']:>2}/{x['images']}  correct {x['correct']:>2}  "
+          f"agreed {x['correct_agreed']:>2}  false kept {x['false_kept']}\t{x['sparse']}")
+PY
+    echo "$line"
+    # Oats: the two cans' camera groups, frames 0-7 and 14-22 (two-copies.py).
+    if [ "$set" = oats ] && [ -n "$sparse" ]; then
+      python3 "$here/scripts/tools/two-copies.py" "$sparse" 0007.png 0014.png | sed 's/^/      /'
+    fi
+  done
+done
