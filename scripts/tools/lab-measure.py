@@ -78,14 +78,19 @@ def run(cmd, logfile=None):
 
 
 def mapper(db, images, out):
-    """`colmap mapper` into out/ (sub-models out/0, out/1, ...), unless done before."""
+    """`colmap mapper` into out/ (sub-models out/0, out/1, ...), on a copy of db (COLMAP 3.8
+    bumps the SQLite change counter of a database it maps, which would make check_inputs refuse
+    the next run), unless done before."""
     if os.path.exists(out + ".done"):
         return
     shutil.rmtree(out, ignore_errors=True)
     os.makedirs(out)
+    copy = out + ".db"
+    shutil.copyfile(db, copy)
     log(f"colmap mapper {db}")
-    run(["colmap", "mapper", "--database_path", db, "--image_path", images, "--output_path", out,
-         "--Mapper.extract_colors", "0"], out + ".log")
+    run(["colmap", "mapper", "--database_path", copy, "--image_path", images, "--output_path",
+         out, "--Mapper.extract_colors", "0"], out + ".log")
+    os.remove(copy)
     open(out + ".done", "w").close()
 
 
