@@ -15,7 +15,7 @@ usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [
             is only roughly a sequence (Oats, Cereal), at the risk of a false pair in it
   --run     a prune + mapper run to score, PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]], e.g.
             paper-disambiguation:order, disambiguation:order:image_id:global or
-            "disambiguation:order:name:global:--sequence_window 3 --keep_pairs near.txt"
+            "disambiguation:order:name:global:--sequence_window 3 --keep_neighbours 3"
             (PRESET `full`: the database unpruned; --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).

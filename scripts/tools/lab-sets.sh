@@ -4,8 +4,8 @@
 # resampled to 4:3), its reference checked by two mappers (lab-measure.py, 3-frame window), and
 # eight runs scored against it with COLMAP 3.8 and 4.2's global mapper: the full database, the
 # disambiguation preset, the paper's preset, `--sequence_window 3` (name order), and the
-# close-neighbour recipe (`--keep_pairs` the pairs within 3 frames, sequence-pairs.py). Oats is
-# also judged by two-copies.py. Prints one line per run; WORK/SET/results.json has everything.
+# close-neighbour recipe (`--keep_neighbours 3`). Oats is also judged by two-copies.py. Prints
+# one line per run; WORK/SET/results.json has everything.
 #
 # usage: scripts/tools/lab-sets.sh [SET ...]   (street books cup oats cereal by default)
 # environment: DATASETS (default ../shared/datasets), WORK (default target/lab-sets)
@@ -28,14 +28,12 @@ for set in "${sets[@]}"; do
     images=$work/$set.db.images
     orbit=
   fi
-  near=$work/$set.near3.txt
-  python3 "$here/scripts/tools/sequence-pairs.py" "$work/$set.db" 3 >"$near"
   runs=()
   for mapper in colmap3.8 global; do
     runs+=(--run "full:order:image_id:$mapper" --run "disambiguation:order:image_id:$mapper"
       --run "paper-disambiguation:order:image_id:$mapper"
       --run "disambiguation:order:name:$mapper:--sequence_window 3"
-      --run "disambiguation:order:name:$mapper:--sequence_window 3 --keep_pairs $near")
+      --run "disambiguation:order:name:$mapper:--sequence_window 3 --keep_neighbours 3")
   done
   python3 "$here/scripts/tools/lab-measure.py" "$set" "$images" "$work/$set" "$work/$set.db" \
     $orbit "${runs[@]}" >/dev/null

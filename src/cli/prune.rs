@@ -84,6 +84,13 @@ pub struct PruneArgs {
     /// order says nothing about overlap.
     #[arg(long, value_name = "W", default_value_t = 0)]
     sequence_window: u32,
+    /// Keep every verified pair of images at most K positions apart in --order, whatever the
+    /// flow selects: for a capture known to be one sequence, whose close neighbours surely see
+    /// the same things (docs/cli.md; 3 on the measured lab photographs, with --sequence_window
+    /// 3). Keep K small: a reach across a walk between look-alike objects keeps false pairs.
+    /// 0: none.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    keep_neighbours: u32,
 }
 
 impl PruneArgs {
@@ -165,6 +172,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
         order: args.order,
         image_path: path_text(&args.image_path),
         sequence_window: args.sequence_window,
+        keep_neighbours: args.keep_neighbours,
         keep_pairs: path_text(&args.keep_pairs),
         forbid_pairs: path_text(&args.forbid_pairs),
         forbid_images: path_text(&args.forbid_images),

@@ -98,6 +98,11 @@ pub struct OrderReport {
     /// `--sequence_window`: images this many positions apart are neighbours in a capture
     /// sequence, which backbone_tracks' backbone keeps to (0: not used).
     pub sequence_window: u32,
+    /// `--keep_neighbours`: pairs of images at most this many positions apart were kept
+    /// whatever the flow selected (0: not used).
+    pub keep_neighbours: u32,
+    /// How many view-graph pairs that kept (besides `--keep_pairs`).
+    pub neighbours_kept: usize,
 }
 
 /// Spread of one prior's fitness over all images or pairs, and over the selected ones.
@@ -208,6 +213,8 @@ impl Report {
                 window,
                 images_without_time: order.images_without_time,
                 sequence_window: parameters.sequence_window,
+                keep_neighbours: parameters.keep_neighbours,
+                neighbours_kept: plan.neighbours_kept,
             },
             outputs: Outputs::default(),
             timings: plan.timings.clone(),
@@ -286,6 +293,12 @@ impl Report {
                 o.keep_pairs.len(),
                 o.forbid_pairs.len(),
                 o.forbid_images.len()
+            );
+        }
+        if self.order.keep_neighbours > 0 {
+            s += &format!(
+                "\nclose neighbours: {} pairs within {} positions kept",
+                self.order.neighbours_kept, self.order.keep_neighbours
             );
         }
         if !self.images_isolated.is_empty() {

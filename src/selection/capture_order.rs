@@ -54,6 +54,9 @@ pub struct Input {
     /// The order is a capture sequence in which images at most this many positions apart see
     /// the same things (`--sequence_window`); 0: it says nothing about overlap.
     pub sequence_window: u32,
+    /// Every view-graph pair of images at most this many positions apart is kept whatever the
+    /// flow selects (`--keep_neighbours`); 0: none.
+    pub keep_neighbours: u32,
 }
 
 /// The order as computed: each view-graph vertex's position.
@@ -71,6 +74,11 @@ pub struct CaptureOrder {
 pub const SEQUENTIAL_WINDOW: u32 = 5;
 
 impl CaptureOrder {
+    /// Whether vertices `i` and `j` are at most `window` positions apart.
+    pub fn within(&self, i: u32, j: u32, window: u32) -> bool {
+        self.rank[i as usize].abs_diff(self.rank[j as usize]) <= window
+    }
+
     /// Share of the given edges (vertex pairs) whose ends are at most `window` positions apart;
     /// None without edges.
     pub fn share_within(
@@ -81,7 +89,7 @@ impl CaptureOrder {
         let (mut near, mut all) = (0usize, 0usize);
         for (i, j) in edges {
             all += 1;
-            near += usize::from(self.rank[i as usize].abs_diff(self.rank[j as usize]) <= window);
+            near += usize::from(self.within(i, j, window));
         }
         (all > 0).then(|| near as f64 / all as f64)
     }

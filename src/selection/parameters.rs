@@ -56,6 +56,10 @@ pub struct Parameters {
     /// sequence (0, and in older records: the order says nothing about overlap).
     #[serde(default)]
     pub sequence_window: u32,
+    /// Pairs of images at most this many positions apart in `order` were kept whatever the
+    /// flow selected (0, and in older records: none).
+    #[serde(default)]
+    pub keep_neighbours: u32,
     /// The override files given (paths as given), for the record.
     pub keep_pairs: Option<String>,
     /// See `keep_pairs`.
@@ -84,6 +88,7 @@ impl Parameters {
             order: Order::default(),
             image_path: None,
             sequence_window: 0,
+            keep_neighbours: 0,
             keep_pairs: None,
             forbid_pairs: None,
             forbid_images: None,
@@ -117,6 +122,7 @@ impl Parameters {
                 order: self.order,
                 image_path: self.image_path.as_ref().map(Into::into),
                 sequence_window: self.sequence_window,
+                keep_neighbours: self.keep_neighbours,
             },
         }
     }

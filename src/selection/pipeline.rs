@@ -89,6 +89,9 @@ pub struct Plan {
     pub network: Restriction,
     /// The overrides applied, by name, for the report.
     pub overrides: Listed,
+    /// View-graph pairs kept as close neighbours in the order (`--keep_neighbours`), besides
+    /// the listed ones.
+    pub neighbours_kept: usize,
     /// The order the pair arcs followed.
     pub order: CaptureOrder,
     /// On the whole view graph (kept pairs included); its criteria and curve are the network's.
@@ -181,6 +184,12 @@ pub fn plan_with(
     let names = options.model.pair_prior_names(options.unweighted_priors);
     let mut scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
     let order = capture_order::compute(&options.capture, &graph, &images, &pairs)?;
+    let neighbours_kept = keep_neighbours(
+        &mut resolved.edges,
+        &graph,
+        &order,
+        options.capture.keep_neighbours,
+    );
     let window = options.capture.sequence_window;
     scene.sequence = (window > 0).then(|| Sequence {
         rank: order.rank.clone(),
@@ -264,6 +273,7 @@ pub fn plan_with(
         costs,
         network,
         overrides: resolved.listed,
+        neighbours_kept,
         order,
         search,
         completion,
@@ -273,6 +283,30 @@ pub fn plan_with(
         timings,
         data_version,
     })
+}
+
+/// Fixes every free edge whose images are at most `window` positions apart in `order`, so the
+/// pair is kept whatever the flow selects; forbidden pairs stay forbidden. Returns how many.
+/// Why: in a capture known to be a sequence, close neighbours see the same things, so their
+/// verified pairs are true, and keeping them all gives a walk between look-alike objects the
+/// redundancy a mapper needs to cross it in one piece (docs/cli.md).
+fn keep_neighbours(
+    rules: &mut [ArcRule],
+    graph: &ViewGraph,
+    order: &CaptureOrder,
+    window: u32,
+) -> usize {
+    if window == 0 {
+        return 0;
+    }
+    let mut kept = 0;
+    for (rule, e) in rules.iter_mut().zip(&graph.edges) {
+        if *rule == ArcRule::Free && order.within(e.i, e.j, window) {
+            *rule = ArcRule::Fixed;
+            kept += 1;
+        }
+    }
+    kept
 }
 
 /// The paper's network on the whole view graph: images indexed by their position in `order`
