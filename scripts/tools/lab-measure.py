@@ -16,7 +16,8 @@ usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [
   --run     a prune + mapper run to score, PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]], e.g.
             paper-disambiguation:order, disambiguation:order:image_id:global or
             "disambiguation:order:name:global:--sequence_window 3 --keep_neighbours 3"
-            (PRESET `full`: the database unpruned; --order, default image_id; mapper colmap3.8
+            (PRESET `full`: the database unpruned; `truth`: exactly the pairs the reference
+            labels true, the best a selection can hand that mapper; --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).
 
@@ -44,6 +45,7 @@ Steps:
 Writes WORK/results.json; prints it. Every step is skipped when its output exists, so a WORK
 folder keeps to the inputs that made it (WORK/inputs.json; other inputs stop with an error).
 """
+import csv
 import functools
 import hashlib
 import json
@@ -216,6 +218,32 @@ def labels(db, work, variant):
     return path
 
 
+def true_pairs_only(db, work, variant, tag):
+    """A copy of db in which only the pairs labelled true stay valid: `prune` keeps the true
+    pairs (`--keep_pairs`) and forbids every other verified pair, so its flow and track
+    completion can add none."""
+    out = os.path.join(work, f"pruned_{tag}.db")
+    if os.path.exists(out):
+        return out
+    con = sqlite3.connect(f"file:{db}?mode=ro", uri=True)
+    names = dict(con.execute("SELECT image_id, name FROM images"))
+    verified = [divmod(p, 2147483647) for p, in
+                con.execute("SELECT pair_id FROM two_view_geometries WHERE rows > 0")]
+    con.close()
+    with open(labels(db, work, variant)) as f:
+        true = {(int(r["image_id1"]), int(r["image_id2"])) for r in csv.DictReader(f)
+                if r["true_pair"] == "1"}
+    lists = {"keep": [p for p in verified if p in true], "forbid": [p for p in verified
+                                                                    if p not in true]}
+    for kind, pairs in lists.items():
+        with open(os.path.join(work, f"{kind}_{tag}.txt"), "w") as f:
+            f.writelines(f"{names[a]} {names[b]}\n" for a, b in pairs)
+    run([VGSEL, "prune", "-q", "--database_path", db, "--output", out, "--overwrite",
+         "--keep_pairs", os.path.join(work, f"keep_{tag}.txt"),
+         "--forbid_pairs", os.path.join(work, f"forbid_{tag}.txt")])
+    return out
+
+
 def aucs(db, work, variant):
     """Per-column AUCs (`vgsel-colmap separation`) of the disambiguation preset's scores, plus the
     paper-disambiguation preset's cost as `paper_cost`."""
@@ -252,6 +280,8 @@ def scored_run(images, work, dbs, spec):
     db = dbs[variant]
     if preset == "full":
         pruned, r = db, None
+    elif preset == "truth":
+        pruned, r = true_pairs_only(db, work, variant, tag), None
     else:
         pruned = os.path.join(work, f"pruned_{tag}.db")
         report = os.path.join(work, f"prune_{tag}.json")
