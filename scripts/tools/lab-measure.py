@@ -87,7 +87,7 @@ def mapper(db, images, out):
         return
     shutil.rmtree(out, ignore_errors=True)
     os.makedirs(out)
-    copy = out + ".db"
+    copy = out + ".mapping.db"  # not out + ".db": truth() keeps its input there
     shutil.copyfile(db, copy)
     log(f"colmap mapper {db}")
     run(["colmap", "mapper", "--database_path", copy, "--image_path", images, "--output_path",
@@ -109,7 +109,7 @@ def global_mapper(db, images, out):
     if os.path.exists(out + ".done"):
         return
     shutil.rmtree(out, ignore_errors=True)
-    copy = out + ".db"
+    copy = out + ".mapping.db"
     shutil.copyfile(db, copy)
     log(f"COLMAP 4.2 global mapper {db}")
     run([pycolmap_python(), os.path.join(ROOT, "scripts", "ci", "colmap4.py"), "map", "global",
