@@ -15,6 +15,7 @@ mod fuzz_db;
 mod generate_graph;
 mod hostile;
 mod keep_neighbours;
+mod lab_summary;
 mod mapper;
 mod migration;
 mod pair_truth;

@@ -7,17 +7,24 @@
 # close-neighbour recipe (`--keep_neighbours 3`), and the reference's true pairs only (the best
 # any selection can hand that mapper). Oats is also judged by two-copies.py. Prints one line per run; WORK/SET/results.json has everything.
 #
+# One matching is not enough to judge a hard set: COLMAP's geometric verification is a RANSAC
+# with a random seed, so every matching of the same keypoints verifies a slightly different set
+# of pairs, and on Oats that alone decides whether the global mapper keeps the cans apart
+# (docs/priors.md, session 11). MATCHINGS=N matches and measures each set N times (matching 1 in
+# WORK, matching K in WORK/matchingK) and ends with each run's outcome over the N matchings.
+#
 # usage: scripts/tools/lab-sets.sh [SET ...]   (street books cup oats cereal by default)
-# environment: DATASETS (default ../shared/datasets), WORK (default target/lab-sets)
+# environment: DATASETS (default ../shared/datasets), WORK (default target/lab-sets),
+#   MATCHINGS (default 1)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 datasets=${DATASETS:-$here/../shared/datasets}
 work=${WORK:-$here/target/lab-sets}
+matchings=${MATCHINGS:-1}
 [ -x "$here/target/release/vgsel-colmap" ] || (cd "$here" && cargo build --release --quiet)
-sets=("$@")
-[ ${#sets[@]} -gt 0 ] || sets=(street books cup oats cereal)
-mkdir -p "$work"
-for set in "${sets[@]}"; do
+# Matches SET into WORKDIR (once) and measures it there; prints one line per run.
+measure_set() {
+  local work=$1 set=$2 images orbit sparse line
   if [ "$set" = cup ]; then
     images=$datasets/cup/images
     ASPECT= bash "$here/scripts/tools/build-db.sh" "$images" "$work/$set.db"
@@ -56,4 +63,21 @@ PY
       python3 "$here/scripts/tools/two-copies.py" "$sparse" 0007.png 0014.png | sed 's/^/      /'
     fi
   done
+}
+sets=("$@")
+[ ${#sets[@]} -gt 0 ] || sets=(street books cup oats cereal)
+workdirs=()
+for k in $(seq 1 "$matchings"); do
+  dir=$work
+  [ "$k" -gt 1 ] && dir=$work/matching$k
+  mkdir -p "$dir"
+  workdirs+=("$dir")
+  for set in "${sets[@]}"; do
+    [ "$matchings" -gt 1 ] && echo "[matching $k]"
+    measure_set "$dir" "$set"
+  done
 done
+if [ "$matchings" -gt 1 ]; then
+  echo "over $matchings matchings:"
+  python3 "$here/scripts/tools/lab-summary.py" "${workdirs[@]}" -- "${sets[@]}"
+fi

@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+"""Each lab-set run's outcome over several matchings of the same images (lab-sets.sh MATCHINGS=N).
+
+usage: scripts/tools/lab-summary.py WORKDIR [WORKDIR ...] -- SET [SET ...]
+
+  WORKDIR   one lab-sets.sh folder per matching (WORKDIR/SET/results.json from lab-measure.py)
+  SET       a set's name (oats is judged by two-copies.py)
+
+Prints per set and run (preset, prune options, mapper) the correct cameras among the images both
+mappers agree on, one figure per matching; for Oats the verdict of two-copies.py instead (apart;
+not apart: folded, or one group shrunk by a link that fixed no scale; or the number of models when
+none holds both cans' camera groups), since its reference cannot judge the link frames.
+"""
+import json
+import os
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def oats_verdict(sparse):
+    """`apart`, `not apart`, or `N models` from two-copies.py's lines for each sub-model."""
+    out = subprocess.run(["python3", os.path.join(HERE, "two-copies.py"), sparse, "0007.png",
+                          "0014.png"], capture_output=True, text=True, check=True).stdout
+    lines = out.strip().splitlines()
+    judged = [line for line in lines if "nothing to merge" not in line]
+    if not judged:
+        return f"{len(lines)} models"
+    return "apart" if all(line.endswith(": apart") for line in judged) else "not apart"
+
+
+def main(argv):
+    if "--" not in argv or argv.index("--") == 0 or argv[-1] == "--":
+        sys.exit(__doc__)
+    workdirs, sets = argv[:argv.index("--")], argv[argv.index("--") + 1:]
+    for name in sets:
+        results = [json.load(open(os.path.join(w, name, "results.json"))) for w in workdirs]
+        print(f"{name}:")
+        keys = []
+        for r in results:
+            for x in r["runs"]:
+                key = (x["preset"], x["prune_args"], x["mapper"])
+                if key not in keys:
+                    keys.append(key)
+        for key in keys:
+            cells = []
+            for r in results:
+                run = next((x for x in r["runs"]
+                            if (x["preset"], x["prune_args"], x["mapper"]) == key), None)
+                if run is None:
+                    cells.append("-")
+                elif name == "oats":
+                    cells.append(oats_verdict(run["sparse"]))
+                else:
+                    judged = run["images"] - len(r["truth"]["uncertain"])
+                    cells.append(f"{run['correct_agreed']}/{judged}")
+            what = " ".join([key[0], *key[1].split()])
+            print(f"  {what:<62} {key[2]:<9} {', '.join(cells)}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
