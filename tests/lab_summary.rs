@@ -5,14 +5,19 @@
 use crate::support::python_tool;
 use std::path::Path;
 
-/// A lab-measure.py results.json for `set` in `workdir`: runs as (preset, prune options, mapper,
-/// correct among the agreed images), 19 images of which `uncertain` are uncertain.
-fn write_results(workdir: &Path, set: &str, uncertain: usize, runs: &[(&str, &str, &str, u32)]) {
+/// A run of lab-measure.py: preset, prune options, mapper, correct among the agreed images,
+/// registered images (of 19).
+type Run<'a> = (&'a str, &'a str, &'a str, u32, u32);
+
+/// A lab-measure.py results.json for `set` in `workdir`: 19 images of which `uncertain` are
+/// uncertain.
+fn write_results(workdir: &Path, set: &str, uncertain: usize, runs: &[Run]) {
     let runs: Vec<_> = runs
         .iter()
-        .map(|&(preset, args, mapper, agreed)| {
+        .map(|&(preset, args, mapper, agreed, registered)| {
             serde_json::json!({"preset": preset, "prune_args": args, "mapper": mapper,
-                "images": 19, "correct_agreed": agreed, "sparse": "unused"})
+                "images": 19, "registered": registered, "correct_agreed": agreed,
+                "sparse": "unused"})
         })
         .collect();
     let names: Vec<String> = (0..uncertain).map(|i| format!("{i:04}.png")).collect();
@@ -30,18 +35,19 @@ fn each_run_gets_one_cell_per_matching_in_order() {
         "street",
         0,
         &[
-            ("full", "", "colmap3.8", 7),
-            ("disambiguation", "", "global", 19),
+            ("full", "", "colmap3.8", 7, 19),
+            ("disambiguation", "", "global", 19, 19),
         ],
     );
-    // The second matching lists its runs in another order, trusts 17 images and lacks a run.
+    // The second matching lists its runs in another order, trusts 17 images, lacks a run and
+    // registers 18 images in another.
     write_results(
         &second,
         "street",
         2,
         &[
-            ("disambiguation", "", "global", 17),
-            ("disambiguation", "--sequence_window 3", "global", 16),
+            ("disambiguation", "", "global", 17, 19),
+            ("disambiguation", "--sequence_window 3", "global", 16, 18),
         ],
     );
     let out = python_tool(
@@ -52,7 +58,11 @@ fn each_run_gets_one_cell_per_matching_in_order() {
     let expected = [
         ("full", "colmap3.8", "7/19, -"),
         ("disambiguation", "global", "19/19, 17/17"),
-        ("disambiguation --sequence_window 3", "global", "-, 16/17"),
+        (
+            "disambiguation --sequence_window 3",
+            "global",
+            "-, 16/17 (18 of 19 registered)",
+        ),
     ];
     for (what, mapper, cells) in expected {
         let line = format!("  {what:<62} {mapper:<9} {cells}");

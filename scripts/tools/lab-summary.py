@@ -7,7 +7,7 @@ usage: scripts/tools/lab-summary.py WORKDIR [WORKDIR ...] -- SET [SET ...]
   SET       a set's name (oats is judged by two-copies.py)
 
 Prints per set and run (preset, prune options, mapper) the correct cameras among the images both
-mappers agree on, one figure per matching; for Oats the verdict of two-copies.py instead (apart;
+mappers agree on, one figure per matching (with the registered images where some are missing); for Oats the verdict of two-copies.py instead (apart;
 not apart: folded, or one group shrunk by a link that fixed no scale; or the number of models when
 none holds both cans' camera groups), since its reference cannot judge the link frames.
 """
@@ -54,7 +54,10 @@ def main(argv):
                     cells.append(oats_verdict(run["sparse"]))
                 else:
                     judged = run["images"] - len(r["truth"]["uncertain"])
-                    cells.append(f"{run['correct_agreed']}/{judged}")
+                    cell = f"{run['correct_agreed']}/{judged}"
+                    if run["registered"] < run["images"]:
+                        cell += f" ({run['registered']} of {run['images']} registered)"
+                    cells.append(cell)
             what = " ".join([key[0], *key[1].split()])
             print(f"  {what:<62} {key[2]:<9} {', '.join(cells)}")
 
