@@ -24,7 +24,7 @@ matchings=${MATCHINGS:-1}
 [ -x "$here/target/release/vgsel-colmap" ] || (cd "$here" && cargo build --release --quiet)
 # Matches SET into WORKDIR (once) and measures it there; prints one line per run.
 measure_set() {
-  local work=$1 set=$2 images orbit sparse line
+  local work=$1 set=$2 images orbit runs sparse line
   if [ "$set" = cup ]; then
     images=$datasets/cup/images
     ASPECT= bash "$here/scripts/tools/build-db.sh" "$images" "$work/$set.db"

@@ -7,9 +7,10 @@ usage: scripts/tools/lab-summary.py WORKDIR [WORKDIR ...] -- SET [SET ...]
   SET       a set's name (oats is judged by two-copies.py)
 
 Prints per set and run (preset, prune options, mapper) the correct cameras among the images both
-mappers agree on, one figure per matching (with the registered images where some are missing); for Oats the verdict of two-copies.py instead (apart;
-not apart: folded, or one group shrunk by a link that fixed no scale; or the number of models when
-none holds both cans' camera groups), since its reference cannot judge the link frames.
+mappers agree on, one figure per matching, with the registered images where some are missing; for
+Oats the verdict of two-copies.py instead (apart; not apart: folded, or one group shrunk by a link
+that fixed no scale; or the number of models when none holds both cans' camera groups), since its
+reference cannot judge the link frames.
 """
 import json
 import os
@@ -30,24 +31,24 @@ def oats_verdict(sparse):
     return "apart" if all(line.endswith(": apart") for line in judged) else "not apart"
 
 
+def run_key(run):
+    """What names a run across matchings: preset, prune options, mapper."""
+    return run["preset"], run["prune_args"], run["mapper"]
+
+
 def main(argv):
     if "--" not in argv or argv.index("--") == 0 or argv[-1] == "--":
         sys.exit(__doc__)
     workdirs, sets = argv[:argv.index("--")], argv[argv.index("--") + 1:]
     for name in sets:
         results = [json.load(open(os.path.join(w, name, "results.json"))) for w in workdirs]
+        runs = [{run_key(x): x for x in r["runs"]} for r in results]
         print(f"{name}:")
-        keys = []
-        for r in results:
-            for x in r["runs"]:
-                key = (x["preset"], x["prune_args"], x["mapper"])
-                if key not in keys:
-                    keys.append(key)
-        for key in keys:
+        # Every run of any matching, in the order the matchings first list them.
+        for key in dict.fromkeys(k for by_key in runs for k in by_key):
             cells = []
-            for r in results:
-                run = next((x for x in r["runs"]
-                            if (x["preset"], x["prune_args"], x["mapper"]) == key), None)
+            for r, by_key in zip(results, runs):
+                run = by_key.get(key)
                 if run is None:
                     cells.append("-")
                 elif name == "oats":
@@ -60,7 +61,6 @@ def main(argv):
                     cells.append(cell)
             what = " ".join([key[0], *key[1].split()])
             print(f"  {what:<62} {key[2]:<9} {', '.join(cells)}")
-
 
 if __name__ == "__main__":
     main(sys.argv[1:])
