@@ -5,7 +5,7 @@
 //! COLMAP and shared by the tests; about a minute on 2 cores, most of it COLMAP 3.8's matching.
 //! Without the venv the tests fail under CI (`CI` set) and are skipped, saying so, elsewhere.
 
-use crate::support::{dump, ok, run_versions, schema, user_version};
+use crate::support::{dump, ok, run_ok, run_versions, schema, user_version};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -36,27 +36,7 @@ fn python() -> Option<PathBuf> {
 
 /// Runs scripts/ci/colmap4.py with the venv's python and returns its stdout.
 fn colmap4(python: &Path, args: &[&Path]) -> String {
-    let out = Command::new(python)
-        .arg(HELPER)
-        .args(args)
-        .output()
-        .expect("running scripts/ci/colmap4.py");
-    assert!(
-        out.status.success(),
-        "colmap4.py {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn run(mut cmd: Command) -> std::process::Output {
-    let out = cmd.output().expect("running a command");
-    assert!(
-        out.status.success(),
-        "{cmd:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+    String::from_utf8(run_ok(Command::new(python).arg(HELPER).args(args)).stdout).unwrap()
 }
 
 struct Fixture {
@@ -103,13 +83,13 @@ fn fixture() -> Option<&'static Fixture> {
                 .args(["--ImageReader.camera_params", params])
                 .args(["--SiftExtraction.use_gpu", "0"])
                 .args(["--SiftExtraction.max_num_features", "1024"]);
-            run(extract);
+            run_ok(&mut extract);
             let mut matcher = Command::new("colmap");
             matcher
                 .args(["exhaustive_matcher", "--database_path"])
                 .arg(&db38)
                 .args(["--SiftMatching.use_gpu", "0"]);
-            run(matcher);
+            run_ok(&mut matcher);
             Some(Fixture {
                 python,
                 images,
@@ -360,7 +340,7 @@ fn python_recipe_prunes_between_matching_and_mapping() {
     .args([f.images.as_os_str(), work.as_os_str()])
     .args(["--vgsel", env!("CARGO_BIN_EXE_vgsel-colmap")])
     .args(["--max_features", "1024", "--", "--preset", "disambiguation"]);
-    let summary: Value = serde_json::from_slice(&run(cmd).stdout).unwrap();
+    let summary: Value = serde_json::from_slice(&run_ok(&mut cmd).stdout).unwrap();
     let n = |k: &str| summary[k].as_u64().unwrap();
     assert!(n("pairs_selected") < n("pairs_total"), "{summary}");
     assert_eq!(n("registered"), 20, "{summary}");

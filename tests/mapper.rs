@@ -1,6 +1,7 @@
 //! End-to-end: a synthetic database through the real `colmap mapper` (3.8), aligned to the
 //! ground truth. Needs `colmap` on PATH (the project's install script provides it).
 
+use crate::support::run_ok;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -19,16 +20,6 @@ fn colmap() -> Command {
         "`colmap` is not on PATH: run the project's install script (it installs COLMAP 3.8)"
     );
     Command::new("colmap")
-}
-
-fn run(mut cmd: Command) {
-    let out = cmd.output().expect("running colmap");
-    assert!(
-        out.status.success(),
-        "{cmd:?} failed: {}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 /// The scene of these tests: 20 images on a closed orbit (about 20 s of mapper time).
@@ -91,7 +82,7 @@ fn map_and_check(dir: &Path, db: &Path, gt: &GroundTruth) {
         .arg("--output_path")
         .arg(&sparse)
         .args(["--Mapper.extract_colors", "0"]);
-    run(cmd);
+    run_ok(&mut cmd);
     eprintln!("colmap mapper: {:.1} s", start.elapsed().as_secs_f64());
     let model = sparse.join("0");
     assert!(model.is_dir(), "mapper wrote no model");
@@ -106,7 +97,7 @@ fn map_and_check(dir: &Path, db: &Path, gt: &GroundTruth) {
         .arg("--output_path")
         .arg(&text)
         .args(["--output_type", "TXT"]);
-    run(cmd);
+    run_ok(&mut cmd);
     let estimated = read_images(&text).unwrap();
     let eval = evaluate(&estimated, &gt.model_images()).unwrap();
     eprintln!(
@@ -170,7 +161,7 @@ fn colmap_reads_the_ground_truth_model() {
             .arg("--output_path")
             .arg(output)
             .args(["--output_type", kind]);
-        run(cmd);
+        run_ok(&mut cmd);
     }
     let images = read_images(&back).unwrap();
     let eval = evaluate(&images, &gt.model_images()).unwrap();

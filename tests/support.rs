@@ -291,19 +291,28 @@ pub fn ok(args: &[&str]) -> std::process::Output {
     out
 }
 
+/// Runs `cmd`, fails the test (with its output) unless it succeeds, and returns its output.
+pub fn run_ok(cmd: &mut std::process::Command) -> std::process::Output {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("running {cmd:?}: {e}"));
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Runs one of the project's Python tools (`script`, relative to the repository) with `python3`
 /// on `path` and `args`, fails the test unless it succeeds, and returns its standard output.
 pub fn python_tool(script: &str, path: &Path, args: &[&str]) -> String {
-    let out = std::process::Command::new("python3")
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join(script))
-        .arg(path)
-        .args(args)
-        .output()
-        .expect("running python3");
-    assert!(
-        out.status.success(),
-        "{script} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = run_ok(
+        std::process::Command::new("python3")
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join(script))
+            .arg(path)
+            .args(args),
     );
     String::from_utf8(out.stdout).unwrap()
 }
