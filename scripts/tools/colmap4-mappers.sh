@@ -6,6 +6,7 @@
 # and scores the models against the ground truth. Prints one row per model and the medians;
 # writes WORKDIR/mappers.json.
 # usage: scripts/tools/colmap4-mappers.sh [WORKDIR] [RUNS]   (defaults: target/colmap4-mappers, 5)
+# PRUNE_ARGS overrides the prune options (default: --preset disambiguation).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 work=${1:-target/colmap4-mappers}
@@ -34,7 +35,9 @@ for run in $(seq 1 "$runs"); do
       nice "$py" scripts/ci/colmap4.py database "$images" "$dir/full.db" --camera_params "$params" \
         >"$dir/match.log" 2>&1
     fi
-    "$bin" prune -q --preset disambiguation --database_path "$dir/full.db" --output "$dir/pruned.db"
+    # shellcheck disable=SC2086 # PRUNE_ARGS is a list of options
+    "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$dir/full.db" \
+      --output "$dir/pruned.db"
     for variant in full pruned; do
       for mapper in global incremental; do
         out=$dir/${mapper}_$variant
