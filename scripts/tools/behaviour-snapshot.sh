@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Everything a user can observe of a vgsel-colmap binary on one database, written to a folder so
 # that two binaries (before and after a refactoring) compare with `diff -r`: every --help text,
-# completions, the man page, a generated database and graph, and for both presets the report JSON (timings and clocks removed),
+# completions, the man page, a generated database and graph, and for every preset and the options that change how a run resolves its parameters the report JSON (timings and clocks removed),
 # the --scores CSV, the pair list, the plots, the pruned database's SQL dump (run times removed),
 # inspect, both exports and the restored dump.
 # usage: scripts/tools/behaviour-snapshot.sh BINARY DATABASE OUTDIR
@@ -43,13 +43,25 @@ rm -f gen.db*
 "$bin" -q generate graph --images 50 --pairs 400 --output generated.graph >/dev/null
 "$bin" man >man.1
 
-for preset in general disambiguation; do
+# Each variant: a folder name and prune options (every preset, and the options that change how
+# the parameters resolve: a fixed flow, criteria, completion, order, arc rules, weights, floor).
+variants=(
+  "general|--preset general"
+  "disambiguation|--preset disambiguation"
+  "paper|--preset paper-disambiguation --order name"
+  "sequence|--preset disambiguation --order name --sequence_window 3 --keep_neighbours 2 --min_pair_fitness 0.5 --weights unique_tracks=0.5"
+  "fixed|--flow 30 --min_num_matches 20"
+  "criteria|--min_image_fraction 1 --min_pairs_per_image 3 --min_pairs_each 2 --biconnected true --spanning_forests 1 --min_track_observations 50 --min_track_length_ratio 0.5"
+)
+for variant in "${variants[@]}"; do
+  preset=${variant%%|*}
+  read -r -a options <<<"${variant#*|}"
   mkdir "$preset"
   cp "$db" "$preset/in.db"
-  "$bin" -q prune --database_path "$preset/in.db" --preset "$preset" --dry_run \
+  "$bin" -q prune --database_path "$preset/in.db" "${options[@]}" --dry_run \
     --report "$preset/dry.json" --scores "$preset/scores.csv" --pairs_out "$preset/pairs.txt" \
     --plots "$preset/plots"
-  "$bin" -q prune --database_path "$preset/in.db" --preset "$preset" --output "$preset/pruned.db" \
+  "$bin" -q prune --database_path "$preset/in.db" "${options[@]}" --output "$preset/pruned.db" \
     --report "$preset/report.json"
   for f in dry report; do strip_times <"$preset/$f.json" >"$preset/$f.clean.json"; rm "$preset/$f.json"; done
   dump "$preset/pruned.db" >"$preset/pruned.sql"
@@ -61,5 +73,7 @@ for preset in general disambiguation; do
   rm -f "$preset"/in.db* "$preset"/pruned.db*
 done
 dump "$db" >original.sql
-cmp -s original.sql general/restored.sql && cmp -s original.sql disambiguation/restored.sql \
-  && echo "restore exact" >restore.txt
+for variant in "${variants[@]}"; do
+  cmp -s original.sql "${variant%%|*}/restored.sql" || exit_restore=1
+done
+[ -z "${exit_restore:-}" ] && echo "restore exact" >restore.txt
