@@ -100,3 +100,24 @@ fn the_product_never_uses_the_evaluation_tooling() {
         "the evaluation tooling is behind the `eval` feature and never used by a prune",
     );
 }
+
+#[test]
+fn the_library_does_not_depend_on_the_argument_parser() {
+    forbid(
+        &[
+            "src/colmap",
+            "src/scene",
+            "src/geometry",
+            "src/priors",
+            "src/costs.rs",
+            "src/selection",
+            "src/outputs",
+            "src/eval",
+            "src/flow",
+            "src/lib.rs",
+            "src/named.rs",
+        ],
+        &["clap"],
+        "the library names its choices (crate::named::Named); only src/cli parses the command line",
+    );
+}

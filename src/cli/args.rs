@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::flow::search::{Criteria, FlowRule, GivenCriteria};
+use vgsel_colmap::named::Named;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -152,6 +153,15 @@ pub fn weights(s: &str) -> Result<Weights, String> {
         )
         .collect::<Result<_, _>>()
         .map(Weights)
+}
+
+/// The parser of an option whose value is one of `T`'s names, listing them with their help.
+pub fn choice<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    let values = T::ALL
+        .iter()
+        .map(|v| PossibleValue::new(v.name()).help(v.help()));
+    PossibleValuesParser::new(values).map(|name| T::from_name(&name).expect("a listed name"))
 }
 
 pub fn fraction(s: &str) -> Result<f64, String> {

@@ -1,7 +1,7 @@
 //! `export`: writes the view graph with each pair's priors, cost and kept/removed, for
 //! Graphviz or networkx.
 
-use super::args::DatabaseArg;
+use super::args::{choice, DatabaseArg};
 use crate::cli::progress::Progress;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -15,7 +15,7 @@ use vgsel_colmap::selection::pipeline;
 pub struct ExportArgs {
     #[command(flatten)]
     database: DatabaseArg,
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<export::Format>())]
     format: export::Format,
     /// The file to write.
     #[arg(long, value_name = "FILE")]

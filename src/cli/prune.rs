@@ -1,13 +1,14 @@
 //! `prune`: selects the pairs the mapper should use and invalidates the others in
 //! two_view_geometries, in place (reversible by `restore`) or in a copy.
 
-use super::args::{fraction, weights, DatabaseArg, FlowArgs, Weights};
+use super::args::{choice, fraction, weights, DatabaseArg, FlowArgs, Weights};
 use crate::cli::progress::Progress;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use vgsel_colmap::colmap::{copy, rewrite};
+use vgsel_colmap::named::Named;
 use vgsel_colmap::outputs::report::{Outputs, Report};
 use vgsel_colmap::outputs::{export, plots, scores};
 use vgsel_colmap::selection::capture_order::Order;
@@ -36,7 +37,7 @@ pub struct PruneArgs {
     #[arg(long, default_value_t = prune::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
     /// Which priors make the costs.
-    #[arg(long, value_enum, default_value = "general")]
+    #[arg(long, value_parser = choice::<Preset>(), default_value = "general")]
     preset: Preset,
     /// Override prior weights: NAME=W[,NAME=W...] (names as in --scores' header). Priors of
     /// weight 0 are computed only for --scores.
@@ -72,7 +73,7 @@ pub struct PruneArgs {
     /// The order the network's pair arcs follow (lower to higher): the paper's flow chains
     /// images along it, so name the capture order when the photos are a sequence (see
     /// docs/cli.md).
-    #[arg(long, value_enum, default_value = "image_id")]
+    #[arg(long, value_parser = choice::<Order>(), default_value = "image_id")]
     order: Order,
     /// The image folder, read for --order exif.
     #[arg(long, value_name = "DIR")]

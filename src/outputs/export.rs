@@ -7,17 +7,36 @@
 //! records it ([`crate::colmap::database::Database::invalidated_pair_ids`]).
 
 use crate::colmap::ids::pair_id;
+use crate::named::Named;
 use crate::selection::pipeline::Plan;
 use std::collections::{BTreeMap, HashSet};
 use std::fmt::Write;
 
 /// The graph file format `export` writes (`--format`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
     /// Graphviz DOT (removed pairs dashed).
     Dot,
     /// GraphML (networkx.read_graphml, Gephi, Cytoscape).
     Graphml,
+}
+
+impl Named for Format {
+    const ALL: &'static [Format] = &[Format::Dot, Format::Graphml];
+
+    fn name(self) -> &'static str {
+        match self {
+            Format::Dot => "dot",
+            Format::Graphml => "graphml",
+        }
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            Format::Dot => "Graphviz DOT (removed pairs dashed)",
+            Format::Graphml => "GraphML (networkx.read_graphml, Gephi, Cytoscape)",
+        }
+    }
 }
 
 /// A typed attribute value, written as each format wants it.

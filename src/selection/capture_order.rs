@@ -21,6 +21,7 @@
 //!   visited before the main line, smallest first, so they cost a short detour, not a jump).
 
 use crate::colmap::database::{Image, VerifiedPair};
+use crate::named::Named;
 use crate::scene::view_graph::ViewGraph;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
@@ -29,12 +30,11 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// Which order orients the pair arcs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Order {
     /// COLMAP's image_id (the paper's network as is).
     #[default]
-    #[value(name = "image_id")]
     ImageId,
     /// File names in natural order (digit runs compared as numbers).
     Name,
@@ -42,6 +42,32 @@ pub enum Order {
     Exif,
     /// Derived from the view graph: depth-first along its maximum spanning tree by inliers.
     Graph,
+}
+
+impl Named for Order {
+    const ALL: &'static [Order] = &[Order::ImageId, Order::Name, Order::Exif, Order::Graph];
+
+    fn name(self) -> &'static str {
+        match self {
+            Order::ImageId => "image_id",
+            Order::Name => "name",
+            Order::Exif => "exif",
+            Order::Graph => "graph",
+        }
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            Order::ImageId => "COLMAP's image_id (the paper's network as is)",
+            Order::Name => "File names in natural order (digit runs compared as numbers)",
+            Order::Exif => {
+                "EXIF DateTimeOriginal of the image files (needs --image_path); images without it last"
+            }
+            Order::Graph => {
+                "Derived from the view graph: depth-first along its maximum spanning tree by inliers"
+            }
+        }
+    }
 }
 
 /// What `prune` is told about the order.

@@ -3,36 +3,30 @@
 
 use crate::costs::CostModel;
 use crate::flow::search::Criteria;
-use clap::ValueEnum;
+use crate::named::Named;
 use serde::{Deserialize, Serialize};
 
 /// A named choice of cost model and search criteria (`prune --preset`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Preset {
-    /// Image priors degree, track fraction, clustering; pair priors inliers, triangulation
-    /// angle, overlap, infinite homography. Search: 90% of images; then the track completion adds
-    /// pairs until every image keeps 100 keypoints on tracks of three or more images (half of its
-    /// own, if fewer) and the tracks keep 0.7 of the full graph's mean length: as many pairs as
-    /// the images need to stay registrable and accurate, which adapts to how densely they overlap.
+    /// The paper's general preset (section 5.2): speed on ordinary scenes.
     General,
-    /// For scenes with duplicate or symmetric structure, whatever the image order: pair prior
-    /// backbone tracks (the share of a pair's inliers that tracks through each image's strongest
-    /// pairs join), pairs below fitness 0.6 never selected (lowered as far as the search needs);
-    /// the paper's context, loop and multiple motions, loop fraction and unique tracks at weight
-    /// 0 (in --scores). Search: 80% of images, 5 pairs per image.
+    /// Duplicate or symmetric structure, whatever the image order.
     Disambiguation,
-    /// The paper's section 5.1 as written, for its lab scenes: context similarity, loop
-    /// consistency and multiple motions with uniform weights, no fitness floor; search: 25% of
-    /// the view graph's pairs (its lab criterion), no image criterion. Relies on the pair arcs
-    /// following the capture order (--order).
+    /// The paper's section 5.1 as written, for comparison.
     #[serde(rename = "paper-disambiguation")]
     PaperDisambiguation,
 }
 
-impl Preset {
-    /// The preset's name on the command line and in reports.
-    pub fn name(self) -> &'static str {
+impl Named for Preset {
+    const ALL: &'static [Preset] = &[
+        Preset::General,
+        Preset::Disambiguation,
+        Preset::PaperDisambiguation,
+    ];
+
+    fn name(self) -> &'static str {
         match self {
             Preset::General => "general",
             Preset::Disambiguation => "disambiguation",
@@ -40,6 +34,16 @@ impl Preset {
         }
     }
 
+    fn help(self) -> &'static str {
+        match self {
+            Preset::General => "Image priors degree, track fraction, clustering; pair priors inliers, triangulation angle, overlap, infinite homography. Search: 90% of images; then the track completion adds pairs until every image keeps 100 keypoints on tracks of three or more images (half of its own, if fewer) and the tracks keep 0.7 of the full graph's mean length: as many pairs as the images need to stay registrable and accurate, which adapts to how densely they overlap",
+            Preset::Disambiguation => "For scenes with duplicate or symmetric structure, whatever the image order: pair prior backbone tracks (the share of a pair's inliers that tracks through each image's strongest pairs join), pairs below fitness 0.6 never selected (lowered as far as the search needs); the paper's context, loop and multiple motions, loop fraction and unique tracks at weight 0 (in --scores). Search: 80% of images, 5 pairs per image",
+            Preset::PaperDisambiguation => "The paper's section 5.1 as written, for its lab scenes: context similarity, loop consistency and multiple motions with uniform weights, no fitness floor; search: 25% of the view graph's pairs (its lab criterion), no image criterion. Relies on the pair arcs following the capture order (--order)",
+        }
+    }
+}
+
+impl Preset {
     /// Which priors make the costs, with their g and weights, and the fitness floor.
     pub fn model(self) -> CostModel {
         match self {
