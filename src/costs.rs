@@ -6,10 +6,10 @@
 //! mean of its priors' fitness. Only encouraging costs (<= 0) are used, as the paper does, so the
 //! flow F stays the one free parameter.
 
-use crate::priors::PriorValues;
+use crate::named::Named;
+use crate::priors::{Prior, PriorValues};
 use anyhow::{bail, Result};
-use serde::de::Error as _;
-use serde::{Deserialize, Deserializer, Serialize};
+use serde::{Deserialize, Serialize};
 
 /// The normalisation g of one prior: a trapezoid with breakpoints k1..k6: `low` below k2, rising
 /// linearly to `high` on [k2, k3), `high` on [k3, k4], falling to `low` on (k4, k5), `low` above.
@@ -112,40 +112,15 @@ impl Trapezoid {
 }
 
 /// How one prior enters the cost.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PriorModel {
-    /// The prior's name, as its [`PriorValues`] carry it and `--weights` names it.
-    pub name: &'static str,
+    /// The prior, which its [`PriorValues`] carry and `--weights` names.
+    #[serde(rename = "name")]
+    pub prior: Prior,
     /// Maps the prior's raw values to fitness in [low, high].
     pub g: Trapezoid,
     /// Relative weight in the weighted mean; at 0 the prior has no say and may go uncomputed.
     pub weight: f64,
-}
-
-/// Read back from a run record: the name must be one of the priors a preset knows, so that it
-/// names the same measurement.
-impl<'de> Deserialize<'de> for PriorModel {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<PriorModel, D::Error> {
-        #[derive(Deserialize)]
-        struct Recorded {
-            name: String,
-            g: Trapezoid,
-            weight: f64,
-        }
-        let r = Recorded::deserialize(d)?;
-        let known = [CostModel::general(), CostModel::disambiguation()];
-        let name = known
-            .iter()
-            .flat_map(|m| m.image_priors.iter().chain(&m.pair_priors))
-            .map(|p| p.name)
-            .find(|&n| n == r.name)
-            .ok_or_else(|| D::Error::custom(format!("unknown prior `{}`", r.name)))?;
-        Ok(PriorModel {
-            name,
-            g: r.g,
-            weight: r.weight,
-        })
-    }
 }
 
 /// A preset: which priors, their g and weights.
@@ -170,10 +145,14 @@ impl CostModel {
         CostModel {
             image_priors: general_image_priors(),
             pair_priors: vec![
-                prior("inliers", Trapezoid::RISE, 1.0),
-                prior("triangulation_angle", Trapezoid::TRIANGULATION_ANGLE, 1.0),
-                prior("overlap", Trapezoid::OVERLAP, 1.0),
-                prior("homography", Trapezoid::HOMOGRAPHY, 1.0),
+                prior(Prior::Inliers, Trapezoid::RISE, 1.0),
+                prior(
+                    Prior::TriangulationAngle,
+                    Trapezoid::TRIANGULATION_ANGLE,
+                    1.0,
+                ),
+                prior(Prior::Overlap, Trapezoid::OVERLAP, 1.0),
+                prior(Prior::Homography, Trapezoid::HOMOGRAPHY, 1.0),
             ],
             node_constant: 1.0,
             min_pair_fitness: 0.0,
@@ -193,15 +172,15 @@ impl CostModel {
         CostModel {
             image_priors: general_image_priors(),
             pair_priors: vec![
-                prior("context", Trapezoid::RISE, 0.0),
-                prior("context_hamming", Trapezoid::FALL, 0.0),
-                prior("context_outside", Trapezoid::RISE, 0.0),
-                prior("loop", Trapezoid::RISE, 0.0),
-                prior("loop_fraction", Trapezoid::FRACTION, 0.0),
-                prior("unique_tracks", Trapezoid::FRACTION, 0.0),
-                prior("backbone_tracks", Trapezoid::FRACTION, 1.0),
-                prior("motion_rotation", Trapezoid::MOTION_ROTATION, 0.0),
-                prior("motion_position", Trapezoid::MOTION_POSITION, 0.0),
+                prior(Prior::Context, Trapezoid::RISE, 0.0),
+                prior(Prior::ContextHamming, Trapezoid::FALL, 0.0),
+                prior(Prior::ContextOutside, Trapezoid::RISE, 0.0),
+                prior(Prior::Loop, Trapezoid::RISE, 0.0),
+                prior(Prior::LoopFraction, Trapezoid::FRACTION, 0.0),
+                prior(Prior::UniqueTracks, Trapezoid::FRACTION, 0.0),
+                prior(Prior::BackboneTracks, Trapezoid::FRACTION, 1.0),
+                prior(Prior::MotionRotation, Trapezoid::MOTION_ROTATION, 0.0),
+                prior(Prior::MotionPosition, Trapezoid::MOTION_POSITION, 0.0),
             ],
             node_constant: 0.0,
             min_pair_fitness: 0.6,
@@ -216,9 +195,9 @@ impl CostModel {
     pub fn paper_disambiguation() -> CostModel {
         let mut model = CostModel::disambiguation();
         for p in &mut model.pair_priors {
-            p.weight = match p.name {
-                "context" | "loop" => 1.0,
-                "motion_rotation" | "motion_position" => 0.5,
+            p.weight = match p.prior {
+                Prior::Context | Prior::Loop => 1.0,
+                Prior::MotionRotation | Prior::MotionPosition => 0.5,
                 _ => 0.0,
             };
         }
@@ -232,14 +211,14 @@ impl CostModel {
             .image_priors
             .iter()
             .chain(&self.pair_priors)
-            .map(|p| p.name)
+            .map(|p| p.prior.name())
             .collect::<Vec<_>>()
             .join(", ");
         match self
             .image_priors
             .iter_mut()
             .chain(self.pair_priors.iter_mut())
-            .find(|p| p.name == name)
+            .find(|p| p.prior.name() == name)
         {
             Some(p) => p.weight = weight,
             None => bail!("no prior `{name}` in this preset (it has {all})"),
@@ -247,24 +226,24 @@ impl CostModel {
         Ok(())
     }
 
-    /// Names of the pair priors to compute: those with a weight, or all of them.
-    pub fn pair_prior_names(&self, unweighted: bool) -> Vec<&'static str> {
+    /// The pair priors to compute: those with a weight, or all of them.
+    pub fn pair_priors_to_compute(&self, unweighted: bool) -> Vec<Prior> {
         self.pair_priors
             .iter()
             .filter(|p| unweighted || p.weight > 0.0)
-            .map(|p| p.name)
+            .map(|p| p.prior)
             .collect()
     }
 }
 
-fn prior(name: &'static str, g: Trapezoid, weight: f64) -> PriorModel {
-    PriorModel { name, g, weight }
+fn prior(prior: Prior, g: Trapezoid, weight: f64) -> PriorModel {
+    PriorModel { prior, g, weight }
 }
 
 fn general_image_priors() -> Vec<PriorModel> {
-    ["degree", "track_fraction", "clustering"]
+    [Prior::Degree, Prior::TrackFraction, Prior::Clustering]
         .into_iter()
-        .map(|n| prior(n, Trapezoid::RISE, 1.0))
+        .map(|p| prior(p, Trapezoid::RISE, 1.0))
         .collect()
 }
 
@@ -307,18 +286,18 @@ pub fn compute(
 fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorValues>, Vec<f64>) {
     let models: Vec<&PriorModel> = models
         .iter()
-        .filter(|m| m.weight > 0.0 || raw.iter().any(|p| p.name == m.name))
+        .filter(|m| m.weight > 0.0 || raw.iter().any(|p| p.prior == m.prior))
         .collect();
     let fitness: Vec<PriorValues> = models
         .iter()
         .map(|m| {
             let values = raw
                 .iter()
-                .find(|p| p.name == m.name)
-                .unwrap_or_else(|| panic!("no values for prior {}", m.name));
+                .find(|p| p.prior == m.prior)
+                .unwrap_or_else(|| panic!("no values for prior {}", m.prior.name()));
             let fit = m.g.apply(&values.values);
             PriorValues {
-                name: m.name,
+                prior: m.prior,
                 values: fit
                     .into_iter()
                     .zip(&values.values)
@@ -352,35 +331,43 @@ mod tests {
     #[test]
     fn the_papers_preset_weighs_context_loop_and_motions_uniformly_without_a_floor() {
         let model = CostModel::paper_disambiguation();
-        let weight = |name| {
+        let weight = |prior| {
             model
                 .pair_priors
                 .iter()
-                .find(|p| p.name == name)
+                .find(|p| p.prior == prior)
                 .unwrap()
                 .weight
         };
-        assert_eq!((weight("context"), weight("loop")), (1.0, 1.0));
-        assert_eq!(weight("motion_rotation") + weight("motion_position"), 1.0);
-        assert_eq!(model.pair_prior_names(false).len(), 4);
+        assert_eq!((weight(Prior::Context), weight(Prior::Loop)), (1.0, 1.0));
+        assert_eq!(
+            weight(Prior::MotionRotation) + weight(Prior::MotionPosition),
+            1.0
+        );
+        assert_eq!(model.pair_priors_to_compute(false).len(), 4);
         assert_eq!(model.min_pair_fitness, 0.0);
         // Where no second motion was found, context and loop count alone.
         let pairs = |values: [f64; 2]| {
-            ["context", "loop", "motion_rotation", "motion_position"]
-                .into_iter()
-                .zip([
-                    vec![0.0, 1.0],
-                    vec![0.0, 1.0],
-                    values.to_vec(),
-                    values.to_vec(),
-                ])
-                .map(|(name, values)| PriorValues { name, values })
-                .collect::<Vec<_>>()
-        };
-        let images: Vec<_> = ["degree", "track_fraction", "clustering"]
+            [
+                Prior::Context,
+                Prior::Loop,
+                Prior::MotionRotation,
+                Prior::MotionPosition,
+            ]
             .into_iter()
-            .map(|name| PriorValues {
-                name,
+            .zip([
+                vec![0.0, 1.0],
+                vec![0.0, 1.0],
+                values.to_vec(),
+                values.to_vec(),
+            ])
+            .map(|(prior, values)| PriorValues { prior, values })
+            .collect::<Vec<_>>()
+        };
+        let images: Vec<_> = [Prior::Degree, Prior::TrackFraction, Prior::Clustering]
+            .into_iter()
+            .map(|prior| PriorValues {
+                prior,
                 values: vec![1.0],
             })
             .collect();
@@ -423,8 +410,8 @@ mod tests {
     fn weighted_mean_and_sign() {
         let mut model = CostModel {
             pair_priors: vec![
-                prior("inliers", Trapezoid::RISE, 1.0),
-                prior("overlap", Trapezoid::OVERLAP, 1.0),
+                prior(Prior::Inliers, Trapezoid::RISE, 1.0),
+                prior(Prior::Overlap, Trapezoid::OVERLAP, 1.0),
             ],
             ..CostModel::general()
         };
@@ -432,25 +419,25 @@ mod tests {
         assert!(model.set_weight("nope", 1.0).is_err());
         let pairs = [
             PriorValues {
-                name: "inliers",
+                prior: Prior::Inliers,
                 values: vec![0.0, 10.0],
             },
             PriorValues {
-                name: "overlap",
+                prior: Prior::Overlap,
                 values: vec![1.0, 0.0],
             },
         ];
         let images = [
             PriorValues {
-                name: "degree",
+                prior: Prior::Degree,
                 values: vec![1.0],
             },
             PriorValues {
-                name: "track_fraction",
+                prior: Prior::TrackFraction,
                 values: vec![0.5],
             },
             PriorValues {
-                name: "clustering",
+                prior: Prior::Clustering,
                 values: vec![0.0],
             },
         ];
@@ -469,19 +456,19 @@ mod tests {
         let model = CostModel {
             image_priors: vec![],
             pair_priors: vec![
-                prior("loop_fraction", Trapezoid::FRACTION, 1.0),
-                prior("motion_rotation", Trapezoid::MOTION_ROTATION, 1.0),
+                prior(Prior::LoopFraction, Trapezoid::FRACTION, 1.0),
+                prior(Prior::MotionRotation, Trapezoid::MOTION_ROTATION, 1.0),
             ],
             node_constant: 0.0,
             min_pair_fitness: 0.0,
         };
         let pairs = [
             PriorValues {
-                name: "loop_fraction",
+                prior: Prior::LoopFraction,
                 values: vec![0.5, 0.5],
             },
             PriorValues {
-                name: "motion_rotation",
+                prior: Prior::MotionRotation,
                 values: vec![f64::NAN, 90.0],
             },
         ];

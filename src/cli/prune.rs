@@ -11,6 +11,7 @@ use vgsel_colmap::colmap::{copy, rewrite};
 use vgsel_colmap::named::Named;
 use vgsel_colmap::outputs::report::{Outputs, Report};
 use vgsel_colmap::outputs::{export, plots, scores};
+use vgsel_colmap::priors::Prior;
 use vgsel_colmap::selection::capture_order::Order;
 use vgsel_colmap::selection::overrides::{NameList, Overrides};
 use vgsel_colmap::selection::parameters::Parameters;
@@ -145,7 +146,11 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     if let Some(floor) = args.min_pair_fitness {
         model.min_pair_fitness = floor;
     }
-    if args.sequence_window > 0 && !model.pair_prior_names(false).contains(&"backbone_tracks") {
+    if args.sequence_window > 0
+        && !model
+            .pair_priors_to_compute(false)
+            .contains(&Prior::BackboneTracks)
+    {
         bail!(
             "--sequence_window shapes the backbone_tracks prior, which --preset {} does not weigh (use --preset disambiguation, or give it a weight with --weights)",
             args.preset.name()

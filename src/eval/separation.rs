@@ -2,6 +2,7 @@
 //! (from [`crate::eval::synth`]): each prior's AUC, and what the selection removed and kept.
 
 use crate::eval::synth::GroundTruth;
+use crate::named::Named;
 use crate::selection::pipeline::Plan;
 use anyhow::{bail, Context, Result};
 use petgraph::unionfind::UnionFind;
@@ -104,7 +105,7 @@ pub fn measure(plan: &Plan, gt: &GroundTruth) -> Separation {
         .pair_fitness
         .iter()
         .map(|p| PriorSeparation {
-            name: p.name.to_string(),
+            name: p.prior.name().to_string(),
             auc: auc(&p.values, &truth),
             coverage_true: share(count(&|k| truth[k] && !p.values[k].is_nan()), true_pairs),
             coverage_false: share(count(&|k| !truth[k] && !p.values[k].is_nan()), false_pairs),

@@ -118,8 +118,11 @@ fn build(plan: &Plan, removed: &HashSet<u64>) -> Graph {
                 .zip(fitness)
                 .flat_map(|(r, f)| {
                     [
-                        (r.name.to_string(), Value::Float(r.values[k])),
-                        (format!("{}_score", f.name), Value::Float(f.values[k])),
+                        (r.prior.name().to_string(), Value::Float(r.values[k])),
+                        (
+                            format!("{}_score", f.prior.name()),
+                            Value::Float(f.values[k]),
+                        ),
                     ]
                 })
                 .collect::<Vec<_>>()

@@ -1,6 +1,7 @@
 //! What a prune did: the JSON report (`--report FILE`) and the short summary on stderr.
 
 use crate::flow::search::CriterionStatus;
+use crate::named::Named;
 use crate::scene::view_graph::{GraphStats, ViewGraph};
 use crate::selection::overrides::Listed;
 use crate::selection::parameters::Parameters;
@@ -156,7 +157,7 @@ impl Report {
             fitness
                 .iter()
                 .map(|f| PriorSummary {
-                    name: f.name,
+                    name: f.prior.name(),
                     applies_to,
                     mean_fitness: mean(f.values.iter().copied()),
                     mean_fitness_selected: mean_where(&f.values, true),

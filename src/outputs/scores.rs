@@ -2,6 +2,7 @@
 //! after g, the pair's cost and whether the selection kept it; for tuning weights and for
 //! checking a prior against ground truth outside this program.
 
+use crate::named::Named;
 use crate::selection::pipeline::Plan;
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
@@ -11,10 +12,10 @@ use std::path::Path;
 pub fn csv(plan: &Plan) -> String {
     let mut out = String::from("image_id1,image_id2,num_inliers");
     for p in &plan.pair_priors {
-        write!(out, ",{}", p.name).unwrap();
+        write!(out, ",{}", p.prior.name()).unwrap();
     }
     for p in &plan.costs.pair_fitness {
-        write!(out, ",{}_fitness", p.name).unwrap();
+        write!(out, ",{}_fitness", p.prior.name()).unwrap();
     }
     out.push_str(",cost,kept\n");
     let field = |x: f64| {

@@ -2,7 +2,7 @@
 //! favour images that connect otherwise separate groups (point-of-view bias in photo
 //! collections); such bridging images have a *low* coefficient, so the fitness is its complement.
 
-use super::PriorValues;
+use super::{Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 
 /// 1 − local clustering coefficient of every vertex: 1 for images that bridge unlinked groups.
@@ -11,7 +11,7 @@ pub fn compute(graph: &ViewGraph) -> PriorValues {
         .map(|v| 1.0 - graph.clustering_coefficient(v))
         .collect();
     PriorValues {
-        name: "clustering",
+        prior: Prior::Clustering,
         values,
     }
 }

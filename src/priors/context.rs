@@ -17,7 +17,7 @@
 //! vector names every other image).
 
 use super::overlap::convex_hull;
-use super::PriorValues;
+use super::{Prior, PriorValues};
 use crate::scene::Scene;
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashSet};
@@ -112,11 +112,11 @@ pub fn compute(scene: &Scene) -> Vec<PriorValues> {
             [cosine(&wi, &wj), hamming(&wi, &wj), cosine(&oi, &oj)]
         })
         .collect();
-    ["context", "context_hamming", "context_outside"]
-        .iter()
+    [Prior::Context, Prior::ContextHamming, Prior::ContextOutside]
+        .into_iter()
         .enumerate()
-        .map(|(c, &name)| PriorValues {
-            name,
+        .map(|(c, prior)| PriorValues {
+            prior,
             values: rows.iter().map(|r| r[c]).collect(),
         })
         .collect()
@@ -171,21 +171,21 @@ mod tests {
         let graph = ViewGraph::build(&images, &pairs, 1);
         let scene = Scene::new(&graph, &pairs, keypoints, vec![(640, 480); 5]);
         let values = compute(&scene);
-        let at = |name: &str, a: u32, b: u32| {
+        let at = |prior: Prior, a: u32, b: u32| {
             let edge = graph
                 .edges
                 .iter()
                 .position(|e| e.i == a - 1 && e.j == b - 1)
                 .unwrap();
-            values.iter().find(|p| p.name == name).unwrap().values[edge]
+            values.iter().find(|p| p.prior == prior).unwrap().values[edge]
         };
         // (1, 2): both images' context is image 3 and the other's copy-mates: identical.
-        assert!(at("context_outside", 1, 2) > 0.99);
+        assert!(at(Prior::ContextOutside, 1, 2) > 0.99);
         // (1, 4): image 1's surroundings match image 3, image 4's match image 5.
-        assert_eq!(at("context_outside", 1, 4), 0.0);
+        assert_eq!(at(Prior::ContextOutside, 1, 4), 0.0);
         // The literal variant sees the shared object features (matched to 2 and 4 by both).
-        assert!(at("context", 1, 4) > 0.0);
-        assert!(at("context_hamming", 1, 4) > at("context_hamming", 1, 2));
+        assert!(at(Prior::Context, 1, 4) > 0.0);
+        assert!(at(Prior::ContextHamming, 1, 4) > at(Prior::ContextHamming, 1, 2));
     }
 
     #[test]
@@ -205,7 +205,10 @@ mod tests {
         let graph = ViewGraph::build(&images(4), &pairs, 1);
         let scene = Scene::new(&graph, &pairs, keypoints[..4].to_vec(), vec![(640, 480); 4]);
         let values = compute(&scene);
-        let outside = &values.iter().find(|p| p.name == "context_outside").unwrap();
+        let outside = &values
+            .iter()
+            .find(|p| p.prior == Prior::ContextOutside)
+            .unwrap();
         let edge = graph
             .edges
             .iter()

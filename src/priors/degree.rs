@@ -1,6 +1,6 @@
 //! Image prior: degree in the view graph. Well-connected images support long tracks.
 
-use super::PriorValues;
+use super::{Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 
 /// Number of view-graph edges of every vertex.
@@ -9,7 +9,7 @@ pub fn compute(graph: &ViewGraph) -> PriorValues {
         .map(|v| graph.degree(v) as f64)
         .collect();
     PriorValues {
-        name: "degree",
+        prior: Prior::Degree,
         values,
     }
 }

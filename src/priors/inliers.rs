@@ -1,6 +1,6 @@
 //! Pair prior: number of verified inlier correspondences.
 
-use super::PriorValues;
+use super::{Prior, PriorValues};
 use crate::scene::Scene;
 
 /// Number of verified inliers of every edge.
@@ -12,7 +12,7 @@ pub fn compute(scene: &Scene) -> PriorValues {
         .map(|e| scene.pairs[e.pair].inliers.len() as f64)
         .collect();
     PriorValues {
-        name: "inliers",
+        prior: Prior::Inliers,
         values,
     }
 }

@@ -8,7 +8,7 @@
 //! centres always are): rotation chaining cannot see a copy that is only translated, and a raw
 //! count favours pairs in dense regions whatever their truth.
 
-use super::PriorValues;
+use super::{Prior, PriorValues};
 use crate::geometry::pose::{rotation_angle_deg, RelativePose};
 use crate::scene::Scene;
 use nalgebra::Rotation3;
@@ -97,11 +97,11 @@ pub fn compute(scene: &Scene, poses: &[Option<RelativePose>]) -> Vec<PriorValues
     let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0).max(1) as f64;
     vec![
         PriorValues {
-            name: "loop",
+            prior: Prior::Loop,
             values: counts.iter().map(|c| c.0 as f64 / median).collect(),
         },
         PriorValues {
-            name: "loop_fraction",
+            prior: Prior::LoopFraction,
             values: counts
                 .iter()
                 .map(|c| match c.2 {

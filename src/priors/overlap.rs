@@ -2,7 +2,7 @@
 //! inlier keypoints divided by the image area. Pairs whose matches cover little of the images
 //! constrain the geometry poorly.
 
-use super::PriorValues;
+use super::{Prior, PriorValues};
 use crate::scene::Scene;
 use rayon::prelude::*;
 
@@ -26,7 +26,7 @@ pub fn compute(scene: &Scene) -> PriorValues {
         })
         .collect();
     PriorValues {
-        name: "overlap",
+        prior: Prior::Overlap,
         values,
     }
 }

@@ -2,7 +2,7 @@
 //! cameras, focal-length estimation and a relative pose per pair; multiple motions also need the
 //! raw matches. [`needs`] tells the pipeline which of those to load into the [`Scene`].
 
-use super::{backbone_tracks, triangulation_angle, unique_tracks, PriorValues};
+use super::{backbone_tracks, triangulation_angle, unique_tracks, Prior, PriorValues};
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
 use crate::geometry::camera::CameraModel;
 use crate::geometry::focal::{self, FundamentalPair};
@@ -33,16 +33,7 @@ pub struct PairPriors {
     pub focal_estimates: Vec<FocalEstimate>,
 }
 
-const POSE_PRIORS: [&str; 6] = [
-    "triangulation_angle",
-    "homography",
-    "loop",
-    "loop_fraction",
-    "motion_rotation",
-    "motion_position",
-];
-
-/// What of the database the priors `names` read beyond the view graph and keypoints.
+/// What of the database the priors `priors` read beyond the view graph and keypoints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Needs {
     /// Cameras and stored two-view geometries (the pose-based priors).
@@ -51,54 +42,53 @@ pub struct Needs {
     pub matches: bool,
 }
 
-/// What computing the priors `names` needs loaded.
-pub fn needs(names: &[&str]) -> Needs {
-    let motion = names.contains(&"motion_rotation") || names.contains(&"motion_position");
+/// What computing `priors` needs loaded.
+pub fn needs(priors: &[Prior]) -> Needs {
     Needs {
-        geometry: POSE_PRIORS.iter().any(|n| names.contains(n)),
-        matches: motion,
+        geometry: priors.iter().any(|p| p.needs_poses()),
+        matches: priors.iter().any(|p| p.needs_matches()),
     }
 }
 
-/// Computes the priors `names` on `scene`, which holds what [`needs`] asked for. `stage` is
-/// told each long step.
-pub fn compute(scene: &Scene, names: &[&str], stage: &dyn Fn(&str)) -> Result<PairPriors> {
-    let wants = |n: &str| names.contains(&n);
+/// Computes `priors` on `scene`, which holds what [`needs`] asked for. `stage` is told each
+/// long step.
+pub fn compute(scene: &Scene, priors: &[Prior], stage: &dyn Fn(&str)) -> Result<PairPriors> {
+    let wants = |p: Prior| priors.contains(&p);
     let mut values = Vec::new();
-    if wants("inliers") {
+    if wants(Prior::Inliers) {
         values.push(inliers::compute(scene));
     }
-    if wants("overlap") {
+    if wants(Prior::Overlap) {
         values.push(overlap::compute(scene));
     }
-    if wants("unique_tracks") {
+    if wants(Prior::UniqueTracks) {
         stage("following tracks");
         values.push(unique_tracks::compute(scene));
     }
-    if wants("backbone_tracks") {
+    if wants(Prior::BackboneTracks) {
         stage("following tracks through the backbone");
         values.push(backbone_tracks::compute(scene));
     }
-    if names.iter().any(|n| n.starts_with("context")) {
+    if wants(Prior::Context) || wants(Prior::ContextHamming) || wants(Prior::ContextOutside) {
         stage("computing context similarity");
         values.extend(context::compute(scene));
     }
     let mut focal_estimates = Vec::new();
-    if POSE_PRIORS.iter().any(|n| wants(n)) {
+    if needs(priors).geometry {
         let (geometry, estimates) = relative_poses(scene, stage)?;
         focal_estimates = estimates;
-        if wants("triangulation_angle") {
+        if wants(Prior::TriangulationAngle) {
             values.push(triangulation_angle::compute(scene, &geometry));
         }
-        if wants("homography") {
+        if wants(Prior::Homography) {
             stage("scoring homographies");
             values.push(homography::compute(scene, &geometry)?);
         }
-        if wants("loop") || wants("loop_fraction") {
+        if wants(Prior::Loop) || wants(Prior::LoopFraction) {
             stage("checking loop consistency");
             values.extend(loop_consistency::compute(scene, &geometry.poses));
         }
-        if wants("motion_rotation") || wants("motion_position") {
+        if wants(Prior::MotionRotation) || wants(Prior::MotionPosition) {
             stage("searching for multiple motions");
             values.extend(multiple_motions::compute(scene, &geometry, &scene.matches)?);
         }

@@ -10,7 +10,7 @@ use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
 use crate::flow::search::{self, FlowRule, SearchResult, SelectionCheck};
 use crate::geometry::camera::CameraModel;
 use crate::priors::pairs::FocalEstimate;
-use crate::priors::{self, PriorValues};
+use crate::priors::{self, Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::{Scene, Sequence};
 use crate::selection::capture_order::{self, CaptureOrder};
@@ -181,7 +181,9 @@ pub fn plan_with(
         );
     }
     let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
-    let names = options.model.pair_prior_names(options.unweighted_priors);
+    let names = options
+        .model
+        .pair_priors_to_compute(options.unweighted_priors);
     let mut scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
     let order = capture_order::compute(&options.capture, &graph, &images, &pairs)?;
     let neighbours_kept = keep_neighbours(
@@ -339,7 +341,7 @@ fn load_scene<'a>(
     pairs: &'a [VerifiedPair],
     images: &[Image],
     cameras: Vec<Camera>,
-    names: &[&str],
+    names: &[Prior],
     stage: &dyn Fn(&str),
 ) -> Result<Scene<'a>> {
     let camera_of: HashMap<u32, u32> = images
