@@ -1,4 +1,4 @@
-//! `scripts/tools/lab-summary.py`, a lab set's runs over several matchings, on results written
+//! `scripts/lab/lab-summary.py`, a lab set's runs over several matchings, on results written
 //! here: each run's cell must come from its own matching and its own run, judged on the images
 //! that matching's reference trusts.
 
@@ -51,7 +51,7 @@ fn each_run_gets_one_cell_per_matching_in_order() {
         ],
     );
     let out = python_tool(
-        "scripts/tools/lab-summary.py",
+        "scripts/lab/lab-summary.py",
         &first,
         &[second.to_str().unwrap(), "--", "street"],
     );

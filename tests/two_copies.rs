@@ -1,4 +1,4 @@
-//! `scripts/tools/two-copies.py`, the written-down ghost check for Oats, on small text models
+//! `scripts/lab/two-copies.py`, the written-down ghost check for Oats, on small text models
 //! built here: two groups of cameras, each round its own cluster of points. The verdict must be
 //! "apart" only when the clusters share no point, lie apart and keep one scale.
 
@@ -73,7 +73,7 @@ fn verdict(first: &[Point], second: &[Point]) -> String {
     let dir = tempfile::tempdir().unwrap();
     write_model(dir.path(), first, second);
     python_tool(
-        "scripts/tools/two-copies.py",
+        "scripts/lab/two-copies.py",
         dir.path(),
         &["0007.png", "0014.png"],
     )

@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """Measurements on a lab photo set without published ground truth (docs/priors.md).
 
-usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
+usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
            [--run PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]] ...]
 
   NAME      the set's name in the output
   IMAGES    its image folder (file names sort in capture order; for the stretched yan2017 frames
-            the square-pixel copy that `ASPECT=4:3 scripts/tools/build-db.sh` makes)
+            the square-pixel copy that `ASPECT=4:3 scripts/lab/build-db.sh` makes)
   WORK      output folder; every step is skipped when its output exists (delete to redo)
-  ORDER.db  the set's database with image ids in capture order (scripts/tools/build-db.sh)
+  ORDER.db  the set's database with image ids in capture order (scripts/lab/build-db.sh)
   VARIANT=DB  more databases of the same images, e.g. shuffled=shuffled1.db (ids in random order)
   --orbit   the capture is a closed orbit (Cup): the sanity check asks the orbit to close
   --window  the sequential graph's reach in frames [3]; more bridges the jumps of a capture that

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """What a prune keeps, against pair labels, without running the mapper (docs/priors.md).
 
-usage: scripts/tools/selection-sweep.py SET=DB:LABELS [...] -- VARIANT=PRUNE_ARGS [...]
+usage: scripts/lab/selection-sweep.py SET=DB:LABELS [...] -- VARIANT=PRUNE_ARGS [...]
 
   SET=DB:LABELS       a matched database (read only; pruned on a temporary copy) and its pair labels
-                      (`vgsel-colmap eval --labels`, from ground truth or scripts/tools/lab-measure.py)
+                      (`vgsel-colmap eval --labels`, from ground truth or scripts/lab/lab-measure.py)
   VARIANT=PRUNE_ARGS  prune options to try, e.g. floor.6="--preset disambiguation --min_pair_fitness 0.6"
 
 Prints one row per variant, one cell per set: false pairs kept / true pairs kept / connected
