@@ -26,6 +26,7 @@ mod separation;
 mod solver;
 mod stray_files;
 mod synth;
+mod test_targets;
 mod track_criterion;
 mod two_copies;
 mod ux;
