@@ -14,6 +14,7 @@ mod focal;
 mod fuzz_db;
 mod generate_graph;
 mod hostile;
+mod inspect_tracks;
 mod keep_neighbours;
 mod mapper;
 mod migration;
