@@ -224,7 +224,7 @@ fn pycolmap_database_prunes_maps_both_ways_and_restores_byte_for_byte() {
     // Both 4.2 mappers on the pruned database. The global mapper's figures are recorded, not
     // asserted: on pycolmap's own matches of this scene the disambiguation prune keeps 100 pairs
     // with 3 to 8 false ones, and the global model stayed ghosted in 10 of 10 fresh matchings
-    // (8 to 11 of 20 correct; full 9), scripts/tools/colmap4-mappers.sh.
+    // (8 to 11 of 20 correct; full 9), scripts/lab/colmap4-mappers.sh.
     let (registered, _) = map(f, "incremental", &pruned, &dir.join("incremental"));
     assert_eq!(registered, 20);
     let (full_registered, full_correct) = map(f, "global", &full, &dir.join("global_full"));

@@ -305,18 +305,6 @@ pub fn run_ok(cmd: &mut std::process::Command) -> std::process::Output {
     out
 }
 
-/// Runs one of the project's Python tools (`script`, relative to the repository) with `python3`
-/// on `path` and `args`, fails the test unless it succeeds, and returns its standard output.
-pub fn python_tool(script: &str, path: &Path, args: &[&str]) -> String {
-    let out = run_ok(
-        std::process::Command::new("python3")
-            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join(script))
-            .arg(path)
-            .args(args),
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
 /// A generated 16-image matched database in a fresh temporary directory.
 pub fn scene() -> (TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();

@@ -5,4 +5,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 export VGSEL_CRASH_RUNS="${1:-300}" VGSEL_CRASH_IMAGES="${2:-80}"
-cargo test --release --test crash -- --nocapture
+# tests/crash.rs is a module of the one integration-test binary (tests/tests.rs): its tests are
+# the ones whose path starts with crash::.
+cargo test --release --test tests crash:: -- --nocapture

@@ -20,4 +20,7 @@ fi
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 # Every public item documented (missing_docs) and every doc link resolved.
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
+# The research lab's own tests (scripts/lab/README.md): standard-library Python, no build. Before
+# cargo's, whose closing line CI reads.
+python3 -m unittest discover -s scripts/lab/tests
 cargo test --workspace --all-targets

@@ -85,8 +85,9 @@ pub struct Completion {
 }
 
 /// Union-find over every keypoint of every image, with track sizes and the running sums that
-/// give the mean track length a keypoint sees.
-struct TrackSet {
+/// give the mean track length a keypoint sees: the feature tracks the mapper builds from a set of
+/// pairs, as the completion measures them (`inspect --tracks` prints them).
+pub struct TrackSet {
     offset: Vec<usize>,
     parent: Vec<u32>,
     size: Vec<u32>,
@@ -109,6 +110,15 @@ impl TrackSet {
             sum: 0,
             sum_sq: 0,
         }
+    }
+
+    /// The tracks made by the inliers of the view-graph edges for which `keep(edge)` holds.
+    pub fn build(scene: &Scene, keep: impl Fn(usize) -> bool) -> TrackSet {
+        let mut tracks = TrackSet::new(scene);
+        for e in (0..scene.graph.edges.len()).filter(|&e| keep(e)) {
+            tracks.add_edge(scene, e);
+        }
+        tracks
     }
 
     fn element(&self, v: u32, kp: u32) -> u32 {
@@ -160,8 +170,8 @@ impl TrackSet {
         joins
     }
 
-    /// Keypoints of `v` on tracks of at least `min_length` observations.
-    fn observations_on_tracks(&mut self, v: u32, min_length: u32) -> usize {
+    /// Keypoints of vertex `v` on tracks of at least `min_length` observations.
+    pub fn observations_on_tracks(&mut self, v: u32, min_length: u32) -> usize {
         let range = self.offset[v as usize] as u32..self.offset[v as usize + 1] as u32;
         range
             .filter(|&x| {
@@ -171,8 +181,14 @@ impl TrackSet {
             .count()
     }
 
-    /// Mean track length a keypoint on a track sees (0 without tracks).
-    fn mean_length(&self) -> f64 {
+    /// Keypoints on tracks of two or more observations (every matched keypoint).
+    pub fn keypoints_on_tracks(&self) -> u64 {
+        self.sum
+    }
+
+    /// Mean track length a keypoint on a track sees (0 without tracks): the sum of s² over the
+    /// sum of s, over tracks of s >= 2 observations.
+    pub fn mean_length(&self) -> f64 {
         if self.sum == 0 {
             0.0
         } else {
@@ -203,14 +219,8 @@ pub fn complete(
 ) -> Completion {
     let selectable = restriction.expand_pairs(&vec![true; restriction.problem.pairs.len()]);
     let edges = scene.graph.edges.len();
-    let mut full = TrackSet::new(scene);
-    for e in (0..edges).filter(|&e| selectable[e] || kept[e]) {
-        full.add_edge(scene, e);
-    }
-    let mut tracks = TrackSet::new(scene);
-    for e in (0..edges).filter(|&e| kept[e]) {
-        tracks.add_edge(scene, e);
-    }
+    let mut full = TrackSet::build(scene, |e| selectable[e] || kept[e]);
+    let mut tracks = TrackSet::build(scene, |e| kept[e]);
     let mut done = Completion {
         pairs_from_flow: kept.iter().filter(|&&k| k).count(),
         track_length_full: full.mean_length(),

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Top views of the camera paths of pipeline.sh's two models, and a written-down ghost check.
 
-usage: scripts/tools/topview.py WORKDIR OUT.png
+usage: scripts/lab/topview.py WORKDIR OUT.png
 
 For each model (WORKDIR/sparse_full, WORKDIR/sparse_pruned; the largest sub-model), the camera
 centres in image-name order (= capture order for the frame sequences) are projected on the plane

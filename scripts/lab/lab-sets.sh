@@ -13,7 +13,7 @@
 # (docs/priors.md, session 11). MATCHINGS=N matches and measures each set N times (matching 1 in
 # WORK, matching K in WORK/matchingK) and ends with each run's outcome over the N matchings.
 #
-# usage: scripts/tools/lab-sets.sh [SET ...]   (street books cup oats cereal by default)
+# usage: scripts/lab/lab-sets.sh [SET ...]   (street books cup oats cereal by default)
 # environment: DATASETS (default ../shared/datasets), WORK (default target/lab-sets),
 #   MATCHINGS (default 1)
 set -euo pipefail
@@ -27,10 +27,10 @@ measure_set() {
   local work=$1 set=$2 images orbit runs sparse line
   if [ "$set" = cup ]; then
     images=$datasets/cup/images
-    ASPECT= bash "$here/scripts/tools/build-db.sh" "$images" "$work/$set.db"
+    ASPECT= bash "$here/scripts/lab/build-db.sh" "$images" "$work/$set.db"
     orbit=--orbit
   else
-    ASPECT=4:3 bash "$here/scripts/tools/build-db.sh" \
+    ASPECT=4:3 bash "$here/scripts/lab/build-db.sh" \
       "$datasets/yan2017_${set}_gifframes/images" "$work/$set.db"
     images=$work/$set.db.images
     orbit=
@@ -43,7 +43,7 @@ measure_set() {
       --run "disambiguation:order:name:$mapper:--sequence_window 3 --keep_neighbours 3"
       --run "truth:order:image_id:$mapper")
   done
-  python3 "$here/scripts/tools/lab-measure.py" "$set" "$images" "$work/$set" "$work/$set.db" \
+  python3 "$here/scripts/lab/lab-measure.py" "$set" "$images" "$work/$set" "$work/$set.db" \
     $orbit "${runs[@]}" >/dev/null
   python3 - "$work/$set/results.json" "$set" <<'PY' | while IFS=$'\t' read -r line sparse; do
 import json, os, sys
@@ -60,7 +60,7 @@ PY
     echo "$line"
     # Oats: the two cans' camera groups, frames 0-7 and 14-22 (two-copies.py).
     if [ "$set" = oats ] && [ -n "$sparse" ]; then
-      python3 "$here/scripts/tools/two-copies.py" "$sparse" 0007.png 0014.png | sed 's/^/      /'
+      python3 "$here/scripts/lab/two-copies.py" "$sparse" 0007.png 0014.png | sed 's/^/      /'
     fi
   done
 }
@@ -79,5 +79,5 @@ for k in $(seq 1 "$matchings"); do
 done
 if [ "$matchings" -gt 1 ]; then
   echo "over $matchings matchings:"
-  python3 "$here/scripts/tools/lab-summary.py" "${workdirs[@]}" -- "${sets[@]}"
+  python3 "$here/scripts/lab/lab-summary.py" "${workdirs[@]}" -- "${sets[@]}"
 fi

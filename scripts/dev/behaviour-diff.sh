@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Compares what two vgsel-colmap binaries show a user on the same databases
-# (scripts/tools/behaviour-snapshot.sh); prints the differences and exits 1 if there are any.
-# usage: scripts/tools/behaviour-diff.sh OLD_BINARY NEW_BINARY WORKDIR DATABASE...
+# (scripts/dev/behaviour-snapshot.sh); prints the differences and exits 1 if there are any.
+# usage: scripts/dev/behaviour-diff.sh OLD_BINARY NEW_BINARY WORKDIR DATABASE...
 set -euo pipefail
 [ $# -ge 4 ] || { echo "usage: $0 OLD_BINARY NEW_BINARY WORKDIR DATABASE..." >&2; exit 2; }
 old=$1 new=$2 work=$3

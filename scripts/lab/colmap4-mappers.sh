@@ -5,7 +5,7 @@
 # and once with pycolmap 4.2, prunes a copy of each, maps all four databases with both mappers
 # and scores the models against the ground truth. Prints one row per model and the medians;
 # writes WORKDIR/mappers.json.
-# usage: scripts/tools/colmap4-mappers.sh [WORKDIR] [RUNS]   (defaults: target/colmap4-mappers, 5)
+# usage: scripts/lab/colmap4-mappers.sh [WORKDIR] [RUNS]   (defaults: target/colmap4-mappers, 5)
 # PRUNE_ARGS overrides the prune options (default: --preset disambiguation).
 set -euo pipefail
 cd "$(dirname "$0")/../.."

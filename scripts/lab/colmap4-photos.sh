@@ -6,7 +6,7 @@
 # against the ground truth, with pair labels from it (`eval --labels`) and the AUC of every prior
 # (`prune --dry_run --scores`, `separation`).
 #
-# usage: scripts/tools/colmap4-photos.sh IMAGES TRUTH WORK
+# usage: scripts/lab/colmap4-photos.sh IMAGES TRUTH WORK
 #   IMAGES  the set's images (read only)
 #   TRUTH   a ground-truth model folder (for the lab sets, lab-measure.py's WORK/truth_txt)
 #   WORK    the database is built there once (WORK/full.db); the rest is redone every run

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Whether a model keeps two look-alike copies apart: the written-down ghost check for Oats.
 
-usage: scripts/tools/two-copies.py MODEL FIRST LAST
+usage: scripts/lab/two-copies.py MODEL FIRST LAST
 
   MODEL  a COLMAP model folder (binary or text); a mapper's output folder with sub-models 0, 1,
          ... is read sub-model by sub-model

@@ -1,5 +1,6 @@
-"""What the measuring scripts read from COLMAP's files, in one place: image names in capture
-order, and text models (camera centres, the 3D points each image sees, the points' positions).
+"""What the measuring scripts read from COLMAP's files, in one place: a database's view graph
+(through the binary, never by SQL of their own), image names in capture order, and text models
+(camera centres, the 3D points each image sees, the points' positions).
 Standard library only, so that the system python runs it.
 """
 import contextlib
@@ -7,6 +8,10 @@ import os
 import re
 import subprocess
 import tempfile
+import xml.etree.ElementTree as ElementTree
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+VGSEL = os.environ.get("VGSEL", os.path.join(ROOT, "target", "release", "vgsel-colmap"))
 
 
 def natural(name):
@@ -14,10 +19,28 @@ def natural(name):
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
 
 
-def name_ranks(con):
-    """image_id -> position in natural name order, for an open COLMAP database."""
-    names = dict(con.execute("SELECT image_id, name FROM images"))
+def name_ranks(names):
+    """image_id -> position in natural name order, of {image_id: name}."""
     return {i: k for k, i in enumerate(sorted(names, key=lambda i: natural(names[i])))}
+
+
+def view_graph(db):
+    """({image_id: name}, [(image_id1, image_id2), ...]) of a database's view graph: its images
+    with verified pairs and those pairs (>= 15 inliers, as the mapper uses them; as originally
+    verified, where the database was pruned), from `vgsel-colmap export --format graphml`."""
+    with tempfile.TemporaryDirectory(prefix="view-graph-") as tmp:
+        path = os.path.join(tmp, "graph.graphml")
+        subprocess.run([VGSEL, "export", "-q", "--database_path", db, "--format", "graphml",
+                        "--output", path], check=True)
+        root = ElementTree.parse(path).getroot()
+    ns = {"g": "http://graphml.graphdrawing.org/xmlns"}
+    key = next(k.get("id") for k in root.iterfind("g:key", ns)
+               if k.get("for") == "node" and k.get("attr.name") == "image_id")
+    ids = {n.get("id"): int(n.find(f"g:data[@key='{key}']", ns).text)
+           for n in root.iterfind("g:graph/g:node", ns)}
+    pairs = [tuple(sorted((ids[e.get("source")], ids[e.get("target")])))
+             for e in root.iterfind("g:graph/g:edge", ns)]
+    return {i: name for name, i in ids.items()}, pairs
 
 
 def camera_centre(qw, qx, qy, qz, tx, ty, tz):

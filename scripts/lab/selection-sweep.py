@@ -1,27 +1,27 @@
 #!/usr/bin/env python3
 """What a prune keeps, against pair labels, without running the mapper (docs/priors.md).
 
-usage: scripts/tools/selection-sweep.py SET=DB:LABELS [...] -- VARIANT=PRUNE_ARGS [...]
+usage: scripts/lab/selection-sweep.py SET=DB:LABELS [...] -- VARIANT=PRUNE_ARGS [...]
 
-  SET=DB:LABELS       a matched database (read only; pruned on a temporary copy) and its pair labels
-                      (`vgsel-colmap eval --labels`, from ground truth or scripts/tools/lab-measure.py)
+  SET=DB:LABELS       a matched database (read only: `prune --dry_run`) and its pair labels
+                      (`vgsel-colmap eval --labels`, from ground truth or scripts/lab/lab-measure.py)
   VARIANT=PRUNE_ARGS  prune options to try, e.g. floor.6="--preset disambiguation --min_pair_fitness 0.6"
 
 Prints one row per variant, one cell per set: false pairs kept / true pairs kept / connected
 components of the kept true pairs over all images (1: the true pairs alone reach every image).
+Kept pairs are those of the view graph (>= 15 inliers, what the mapper uses) that the prune
+selects (`--pairs_out`).
 environment: VGSEL (the binary) [target/release/vgsel-colmap]
 """
+import functools
+import json
 import os
 import shlex
-import shutil
-import sqlite3
 import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-VGSEL = os.environ.get("VGSEL", os.path.join(ROOT, "target", "release", "vgsel-colmap"))
-PAIR = 2147483647
+from colmap_files import VGSEL, view_graph
 
 
 def labels(path):
@@ -48,21 +48,26 @@ def components(images, edges):
     return len({find(i) for i in images})
 
 
+@functools.lru_cache(maxsize=None)
+def images(db):
+    """({name: image_id} of the view graph, images without a verified pair) of a database."""
+    names, _ = view_graph(db)
+    inspect = subprocess.run([VGSEL, "inspect", "--json", "--database_path", db], check=True,
+                             capture_output=True, text=True).stdout
+    return {name: i for i, name in names.items()}, json.loads(inspect)["images_total"] - len(names)
+
+
 def outcome(db, lab, args, tmp):
-    copy = os.path.join(tmp, "sweep.db")
-    for suffix in ("", "-wal", "-shm"):
-        if os.path.exists(copy + suffix):
-            os.remove(copy + suffix)
-    shutil.copyfile(db, copy)
-    subprocess.run([VGSEL, "prune", "-q", "--database_path", copy, *args], check=True)
-    con = sqlite3.connect(copy)
-    kept = [divmod(p, PAIR) for (p,) in con.execute(
-        "SELECT pair_id FROM two_view_geometries WHERE config >= 2 AND rows > 0")]
-    images = [i for (i,) in con.execute("SELECT image_id FROM images")]
-    con.close()
+    ids, isolated = images(db)
+    pairs = os.path.join(tmp, "pairs.txt")
+    subprocess.run([VGSEL, "prune", "-q", "--database_path", db, "--dry_run", "--pairs_out",
+                    pairs, *args], check=True)
+    with open(pairs) as f:
+        kept = [tuple(sorted(ids[name] for name in line.split())) for line in f]
     true = [p for p in kept if lab.get(p)]
     false = sum(1 for p in kept if lab.get(p) is False)
-    return f"{false}/{len(true)}/{components(images, true)}"
+    # An image without a verified pair is a component of its own.
+    return f"{false}/{len(true)}/{components(ids.values(), true) + isolated}"
 
 
 def main(argv):

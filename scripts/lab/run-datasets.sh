@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs scripts/pipeline.sh on the real image sets in ../shared/datasets (never copied into the
 # project) and prints a markdown results table; one set at a time, as COLMAP uses both cores.
-# usage: scripts/tools/run-datasets.sh [SET ...]   (default: the small sets; WORK=target/datasets)
+# usage: scripts/lab/run-datasets.sh [SET ...]   (default: the small sets; WORK=target/datasets)
 # environment: DATASETS (default ../shared/datasets), WORK, and everything pipeline.sh reads.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
@@ -19,15 +19,15 @@ for set in "${sets[@]}"; do
   images=$datasets/$set/images
   if [[ $set == yan2017_*_gifframes ]]; then
     # 4:3 photographs stretched to 840x526: back to square pixels first (docs/priors.md).
-    [ -d "$work/$set.images" ] || "$py" "$here/scripts/tools/unstretch.py" "$images" "$work/$set.images" 4:3
+    [ -d "$work/$set.images" ] || "$py" "$here/scripts/lab/unstretch.py" "$images" "$work/$set.images" 4:3
     images=$work/$set.images
   fi
   bash "$here/scripts/pipeline.sh" "$images" "$work/$set" $gt >&2 ||
     echo "run-datasets: $set failed (see $work/$set)" >&2
 done
-python3 "$here/scripts/tools/results-table.py" "$work" "${sets[@]}"
-# Sets without ground truth: the written-down ghost check on the camera paths (scripts/tools/topview.py).
+python3 "$here/scripts/lab/results-table.py" "$work" "${sets[@]}"
+# Sets without ground truth: the written-down ghost check on the camera paths (scripts/lab/topview.py).
 for set in "${sets[@]}"; do
   [ -f "$datasets/$set/gt/colmap_text/images.txt" ] || [ ! -f "$work/$set/summary.json" ] && continue
-  "$py" "$here/scripts/tools/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"
+  "$py" "$here/scripts/lab/topview.py" "$work/$set" "$work/$set/topview.png" | sed "s/^/$set /"
 done

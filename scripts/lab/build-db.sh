@@ -5,13 +5,13 @@
 # features are extracted from symlinks with shuffled names, and the real names are written back
 # into the images table afterwards (nothing else in the database refers to a name).
 #
-# usage: scripts/tools/build-db.sh IMAGES OUT.db [SEED]
+# usage: scripts/lab/build-db.sh IMAGES OUT.db [SEED]
 #   IMAGES  folder of images (read only)
 #   OUT.db  written once: an existing OUT.db with OUT.db.done next to it is kept as it is
 #   SEED    shuffle the image ids with this seed (none: ids in file-name order, as COLMAP does)
 # environment: MAX_FEATURES [2000]
 #   ASPECT=W:H  the images were stretched from this aspect ratio: they are resampled to it first
-#   (same height, scripts/tools/unstretch.py) into OUT.images/, the folder to map them from. The
+#   (same height, scripts/lab/unstretch.py) into OUT.images/, the folder to map them from. The
 #   yan2017 GIF frames (Street, Books, Oats, Cereal: 840x526, stretched from 4:3 photographs)
 #   need ASPECT=4:3: with the stretch, one focal length cannot fit them (a PINHOLE camera on
 #   Books' frames converges to fx/fy = 1.197, the stretch's 1.198; docs/priors.md).

@@ -4,7 +4,7 @@
 # completions, the man page, a generated database and graph, and for every preset and the options that change how a run resolves its parameters the report JSON (timings and clocks removed),
 # the --scores CSV, the pair list, the plots, the pruned database's SQL dump (run times removed),
 # inspect, both exports and the restored dump.
-# usage: scripts/tools/behaviour-snapshot.sh BINARY DATABASE OUTDIR
+# usage: scripts/dev/behaviour-snapshot.sh BINARY DATABASE OUTDIR
 set -euo pipefail
 [ $# -eq 3 ] || { echo "usage: $0 BINARY DATABASE OUTDIR" >&2; exit 2; }
 bin=$(realpath "$1")

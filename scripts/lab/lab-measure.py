@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """Measurements on a lab photo set without published ground truth (docs/priors.md).
 
-usage: scripts/tools/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
+usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
            [--run PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]] ...]
 
   NAME      the set's name in the output
   IMAGES    its image folder (file names sort in capture order; for the stretched yan2017 frames
-            the square-pixel copy that `ASPECT=4:3 scripts/tools/build-db.sh` makes)
+            the square-pixel copy that `ASPECT=4:3 scripts/lab/build-db.sh` makes)
   WORK      output folder; every step is skipped when its output exists (delete to redo)
-  ORDER.db  the set's database with image ids in capture order (scripts/tools/build-db.sh)
+  ORDER.db  the set's database with image ids in capture order (scripts/lab/build-db.sh)
   VARIANT=DB  more databases of the same images, e.g. shuffled=shuffled1.db (ids in random order)
   --orbit   the capture is a closed orbit (Cup): the sanity check asks the orbit to close
   --window  the sequential graph's reach in frames [3]; more bridges the jumps of a capture that
@@ -53,15 +53,11 @@ import math
 import os
 import re
 import shutil
-import sqlite3
 import subprocess
 import sys
 
-from colmap_files import name_ranks, natural, read_images
+from colmap_files import ROOT, VGSEL, name_ranks, natural, read_images, view_graph
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-VGSEL = os.environ.get("VGSEL", os.path.join(ROOT, "target", "release", "vgsel-colmap"))
 WINDOW = 3
 
 
@@ -118,21 +114,26 @@ def global_mapper(db, images, out):
     open(out + ".done", "w").close()
 
 
-def sequential_copy(db, out):
+def only_pairs(db, out, keep, work, tag):
+    """A copy `out` of db in which, of the view graph's pairs, exactly those for which
+    `keep(rank, a, b)` holds stay valid (rank: image_id -> position in name order): `prune` keeps
+    them (`--keep_pairs`) and forbids every other (`--forbid_pairs`), so its flow and track
+    completion can add none. Pairs below the mapper's 15 inliers are left as they are."""
+    names, pairs = view_graph(db)
+    rank = name_ranks(names)
+    lists = {"keep": [p for p in pairs if keep(rank, *p)],
+             "forbid": [p for p in pairs if not keep(rank, *p)]}
+    for kind, chosen in lists.items():
+        with open(os.path.join(work, f"{kind}_{tag}.txt"), "w") as f:
+            f.writelines(f"{names[a]} {names[b]}\n" for a, b in chosen)
+    run([VGSEL, "prune", "-q", "--database_path", db, "--output", out, "--overwrite",
+         "--keep_pairs", os.path.join(work, f"keep_{tag}.txt"),
+         "--forbid_pairs", os.path.join(work, f"forbid_{tag}.txt")])
+
+
+def sequential_copy(db, out, work):
     """A copy of db keeping only the verified pairs at most WINDOW frames apart by name."""
-    tmp = out + ".tmp"
-    shutil.copyfile(db, tmp)
-    con = sqlite3.connect(tmp)
-    rank = name_ranks(con)
-    far = []
-    for (pid,) in con.execute("SELECT pair_id FROM two_view_geometries"):
-        a, b = divmod(pid, 2147483647)
-        if abs(rank[a] - rank[b]) > WINDOW:
-            far.append((pid,))
-    con.executemany("DELETE FROM two_view_geometries WHERE pair_id = ?", far)
-    con.commit()
-    con.close()
-    os.replace(tmp, out)
+    only_pairs(db, out, lambda rank, a, b: abs(rank[a] - rank[b]) <= WINDOW, work, "sequential")
 
 
 def sweep_deg(points):
@@ -165,7 +166,7 @@ def truth(images, order_db, work, orbit):
         return json.load(open(path))
     seq_db = os.path.join(work, "sequential.db")
     if not os.path.exists(seq_db):
-        sequential_copy(order_db, seq_db)
+        sequential_copy(order_db, seq_db, work)
     sparse = os.path.join(work, "sequential")
     mapper(seq_db, images, sparse)
     glob = os.path.join(work, "sequential_global")
@@ -219,28 +220,14 @@ def labels(db, work, variant):
 
 
 def true_pairs_only(db, work, variant, tag):
-    """A copy of db in which only the pairs labelled true stay valid: `prune` keeps the true
-    pairs (`--keep_pairs`) and forbids every other verified pair, so its flow and track
-    completion can add none."""
+    """A copy of db in which only the pairs labelled true stay valid."""
     out = os.path.join(work, f"pruned_{tag}.db")
     if os.path.exists(out):
         return out
-    con = sqlite3.connect(f"file:{db}?mode=ro", uri=True)
-    names = dict(con.execute("SELECT image_id, name FROM images"))
-    verified = [divmod(p, 2147483647) for p, in
-                con.execute("SELECT pair_id FROM two_view_geometries WHERE rows > 0")]
-    con.close()
     with open(labels(db, work, variant)) as f:
         true = {(int(r["image_id1"]), int(r["image_id2"])) for r in csv.DictReader(f)
                 if r["true_pair"] == "1"}
-    lists = {"keep": [p for p in verified if p in true], "forbid": [p for p in verified
-                                                                    if p not in true]}
-    for kind, pairs in lists.items():
-        with open(os.path.join(work, f"{kind}_{tag}.txt"), "w") as f:
-            f.writelines(f"{names[a]} {names[b]}\n" for a, b in pairs)
-    run([VGSEL, "prune", "-q", "--database_path", db, "--output", out, "--overwrite",
-         "--keep_pairs", os.path.join(work, f"keep_{tag}.txt"),
-         "--forbid_pairs", os.path.join(work, f"forbid_{tag}.txt")])
+    only_pairs(db, out, lambda rank, a, b: (a, b) in true, work, tag)
     return out
 
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Each lab-set run's outcome over several matchings of the same images (lab-sets.sh MATCHINGS=N).
 
-usage: scripts/tools/lab-summary.py WORKDIR [WORKDIR ...] -- SET [SET ...]
+usage: scripts/lab/lab-summary.py WORKDIR [WORKDIR ...] -- SET [SET ...]
 
   WORKDIR   one lab-sets.sh folder per matching (WORKDIR/SET/results.json from lab-measure.py)
   SET       a set's name (oats is judged by two-copies.py)

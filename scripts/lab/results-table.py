@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Markdown table of pipeline.sh runs: one row per set, full -> pruned in each cell.
 
-usage: scripts/tools/results-table.py WORK SET...   (reads WORK/SET/summary.json)
+usage: scripts/lab/results-table.py WORK SET...   (reads WORK/SET/summary.json)
 """
 import json
 import os

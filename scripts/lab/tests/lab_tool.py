@@ -1,0 +1,17 @@
+"""Runs one of the lab's scripts as a user would, for the lab's tests."""
+import os
+import subprocess
+import sys
+
+LAB = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def run(script, *args):
+    """Standard output of `python3 scripts/lab/SCRIPT ARGS...`; raises, with its output, unless
+    it succeeds."""
+    out = subprocess.run([sys.executable, os.path.join(LAB, script), *map(str, args)],
+                         capture_output=True, text=True)
+    if out.returncode != 0:
+        raise AssertionError(f"{script} {' '.join(map(str, args))} failed ({out.returncode}):\n"
+                             f"{out.stdout}\n{out.stderr}")
+    return out.stdout
