@@ -123,7 +123,15 @@ pub struct PriorModel {
     pub weight: f64,
 }
 
-/// A preset: which priors, their g and weights.
+impl PriorModel {
+    /// `prior` through `g` at `weight`.
+    pub fn new(prior: Prior, g: Trapezoid, weight: f64) -> PriorModel {
+        PriorModel { prior, g, weight }
+    }
+}
+
+/// Which priors make the costs, their g and weights (a preset's, [`crate::selection::preset`],
+/// with the user's changes).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CostModel {
     /// Priors of images, which give the costs of the network's image arcs.
@@ -139,72 +147,6 @@ pub struct CostModel {
 }
 
 impl CostModel {
-    /// The paper's `general` preset (section 5.2) with the authors' breakpoints and uniform
-    /// weights.
-    pub fn general() -> CostModel {
-        CostModel {
-            image_priors: general_image_priors(),
-            pair_priors: vec![
-                prior(Prior::Inliers, Trapezoid::RISE, 1.0),
-                prior(
-                    Prior::TriangulationAngle,
-                    Trapezoid::TRIANGULATION_ANGLE,
-                    1.0,
-                ),
-                prior(Prior::Overlap, Trapezoid::OVERLAP, 1.0),
-                prior(Prior::Homography, Trapezoid::HOMOGRAPHY, 1.0),
-            ],
-            node_constant: 1.0,
-            min_pair_fitness: 0.0,
-        }
-    }
-
-    /// The `disambiguation` preset (section 5.1, with a prior of our own): pair costs from
-    /// `backbone_tracks` alone (the share of a pair's inliers that tracks through each image's
-    /// strongest pairs join), which needs no image order. Measured (docs/priors.md): AUC 0.91 to
-    /// 0.95 on real photographs whatever the order, where the paper's priors and `unique_tracks`
-    /// reach 0.80 at best; 0.60 to 0.70 on sparse rendered scenes, where `unique_tracks` and
-    /// `loop_fraction` rank better (0.88 to 0.91, 0.79 to 0.87) but their mean with it kept more
-    /// false pairs on real photographs and split one reconstruction. Every other prior is computed
-    /// for `--scores` only (weight 0; set them with `--weights`). Image costs are off (node
-    /// constant 0) so that pair evidence alone decides.
-    pub fn disambiguation() -> CostModel {
-        CostModel {
-            image_priors: general_image_priors(),
-            pair_priors: vec![
-                prior(Prior::Context, Trapezoid::RISE, 0.0),
-                prior(Prior::ContextHamming, Trapezoid::FALL, 0.0),
-                prior(Prior::ContextOutside, Trapezoid::RISE, 0.0),
-                prior(Prior::Loop, Trapezoid::RISE, 0.0),
-                prior(Prior::LoopFraction, Trapezoid::FRACTION, 0.0),
-                prior(Prior::UniqueTracks, Trapezoid::FRACTION, 0.0),
-                prior(Prior::BackboneTracks, Trapezoid::FRACTION, 1.0),
-                prior(Prior::MotionRotation, Trapezoid::MOTION_ROTATION, 0.0),
-                prior(Prior::MotionPosition, Trapezoid::MOTION_POSITION, 0.0),
-            ],
-            node_constant: 0.0,
-            min_pair_fitness: 0.6,
-        }
-    }
-
-    /// The paper's section 5.1 as written: context similarity (the paper's cosine), loop
-    /// consistency (the paper's count over the median) and multiple motions with uniform
-    /// weights (the two motion terms share one prior's weight and count only where a second
-    /// motion was found), no fitness floor. Kept as the paper has it for comparison: on real
-    /// photographs it works only with the pair arcs in capture order (docs/priors.md).
-    pub fn paper_disambiguation() -> CostModel {
-        let mut model = CostModel::disambiguation();
-        for p in &mut model.pair_priors {
-            p.weight = match p.prior {
-                Prior::Context | Prior::Loop => 1.0,
-                Prior::MotionRotation | Prior::MotionPosition => 0.5,
-                _ => 0.0,
-            };
-        }
-        model.min_pair_fitness = 0.0;
-        model
-    }
-
     /// Sets a prior's weight; unknown names are an error listing the model's priors.
     pub fn set_weight(&mut self, name: &str, weight: f64) -> Result<()> {
         let all = self
@@ -234,17 +176,6 @@ impl CostModel {
             .map(|p| p.prior)
             .collect()
     }
-}
-
-fn prior(prior: Prior, g: Trapezoid, weight: f64) -> PriorModel {
-    PriorModel { prior, g, weight }
-}
-
-fn general_image_priors() -> Vec<PriorModel> {
-    [Prior::Degree, Prior::TrackFraction, Prior::Clustering]
-        .into_iter()
-        .map(|p| prior(p, Trapezoid::RISE, 1.0))
-        .collect()
 }
 
 /// Costs of every image and pair, with each prior's fitness kept for reports.
@@ -329,56 +260,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_papers_preset_weighs_context_loop_and_motions_uniformly_without_a_floor() {
-        let model = CostModel::paper_disambiguation();
-        let weight = |prior| {
-            model
-                .pair_priors
-                .iter()
-                .find(|p| p.prior == prior)
-                .unwrap()
-                .weight
-        };
-        assert_eq!((weight(Prior::Context), weight(Prior::Loop)), (1.0, 1.0));
-        assert_eq!(
-            weight(Prior::MotionRotation) + weight(Prior::MotionPosition),
-            1.0
-        );
-        assert_eq!(model.pair_priors_to_compute(false).len(), 4);
-        assert_eq!(model.min_pair_fitness, 0.0);
-        // Where no second motion was found, context and loop count alone.
-        let pairs = |values: [f64; 2]| {
-            [
-                Prior::Context,
-                Prior::Loop,
-                Prior::MotionRotation,
-                Prior::MotionPosition,
-            ]
-            .into_iter()
-            .zip([
-                vec![0.0, 1.0],
-                vec![0.0, 1.0],
-                values.to_vec(),
-                values.to_vec(),
-            ])
-            .map(|(prior, values)| PriorValues { prior, values })
-            .collect::<Vec<_>>()
-        };
-        let images: Vec<_> = [Prior::Degree, Prior::TrackFraction, Prior::Clustering]
-            .into_iter()
-            .map(|prior| PriorValues {
-                prior,
-                values: vec![1.0],
-            })
-            .collect();
-        let costs = compute(&model, &images, &pairs([f64::NAN, f64::NAN]));
-        assert_eq!(costs.pair_costs, [0.0, -1.0]);
-        // A second motion 90 degrees off counts as one prior at fitness 0: (0 + 1 + 0) / 3.
-        let costs = compute(&model, &images, &pairs([90.0, 90.0]));
-        assert!((costs.pair_costs[1] + 2.0 / 3.0).abs() < 1e-12);
-    }
-
-    #[test]
     fn trapezoid_pieces() {
         // The authors' triangulation-angle g: rise 2 -> 45, flat to 90, fall to 120.
         let g = Trapezoid {
@@ -410,10 +291,14 @@ mod tests {
     fn weighted_mean_and_sign() {
         let mut model = CostModel {
             pair_priors: vec![
-                prior(Prior::Inliers, Trapezoid::RISE, 1.0),
-                prior(Prior::Overlap, Trapezoid::OVERLAP, 1.0),
+                PriorModel::new(Prior::Inliers, Trapezoid::RISE, 1.0),
+                PriorModel::new(Prior::Overlap, Trapezoid::OVERLAP, 1.0),
             ],
-            ..CostModel::general()
+            image_priors: [Prior::Degree, Prior::TrackFraction, Prior::Clustering]
+                .map(|p| PriorModel::new(p, Trapezoid::RISE, 1.0))
+                .to_vec(),
+            node_constant: 1.0,
+            min_pair_fitness: 0.0,
         };
         model.set_weight("overlap", 3.0).unwrap();
         assert!(model.set_weight("nope", 1.0).is_err());
@@ -456,8 +341,8 @@ mod tests {
         let model = CostModel {
             image_priors: vec![],
             pair_priors: vec![
-                prior(Prior::LoopFraction, Trapezoid::FRACTION, 1.0),
-                prior(Prior::MotionRotation, Trapezoid::MOTION_ROTATION, 1.0),
+                PriorModel::new(Prior::LoopFraction, Trapezoid::FRACTION, 1.0),
+                PriorModel::new(Prior::MotionRotation, Trapezoid::MOTION_ROTATION, 1.0),
             ],
             node_constant: 0.0,
             min_pair_fitness: 0.0,

@@ -93,9 +93,9 @@ enum Command {
 }
 
 /// The command line as parsed and as documented (completions, man page): the derived one with
-/// the dashed aliases of the underscore options.
+/// the dashed aliases of the underscore options and the preset table's defaults in the help.
 fn command() -> clap::Command {
-    cli::dashed_aliases(Cli::command())
+    cli::dashed_aliases(cli::args::preset_defaults(Cli::command()))
 }
 
 /// [`Parser::parse`], on [`command`].

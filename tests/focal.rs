@@ -2,10 +2,10 @@
 //! (1.2 × max(width, height), prior_focal_length = 0) and UNCALIBRATED geometries.
 
 use vgsel_colmap::colmap::database::Database;
-use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::eval::synth::{generate, SceneSpec};
-use vgsel_colmap::flow::search::FlowRule;
-use vgsel_colmap::selection::pipeline::{plan, Options};
+use vgsel_colmap::selection::arc_rules::Overrides;
+use vgsel_colmap::selection::parameters::{Given, Parameters};
+use vgsel_colmap::selection::pipeline::plan;
 
 #[test]
 fn guessed_focal_length_is_replaced_by_the_estimate() {
@@ -20,19 +20,19 @@ fn guessed_focal_length_is_replaced_by_the_estimate() {
     };
     generate(&spec, &path).unwrap();
     let db = Database::open_read_only(&path).unwrap();
-    let options = Options {
-        min_num_matches: 15,
-        rule: FlowRule::Fixed(4),
-        model: CostModel::general(),
-        unweighted_priors: false,
-        curve_factor: 0,
-        capture: Default::default(),
-        min_track_observations: 0,
-        min_track_length_ratio: 0.0,
-        spanning_forests: 0,
-        biconnected: false,
+    let given = Given {
+        flow: Some(4),
+        ..Given::default()
     };
-    let p = plan(&db, &options, &|_| {}).unwrap();
+    let parameters = Parameters::resolve(given).unwrap();
+    let p = plan(
+        &db,
+        &parameters,
+        &Overrides::default(),
+        Default::default(),
+        &|_| {},
+    )
+    .unwrap();
     assert_eq!(p.focal_estimates.len(), 1);
     let e = &p.focal_estimates[0];
     assert_eq!(e.guessed, 576.0);

@@ -5,21 +5,22 @@
 
 use std::time::Instant;
 use vgsel_colmap::colmap::database::Database;
-use vgsel_colmap::costs::CostModel;
 use vgsel_colmap::eval::separation::{measure, Separation};
 use vgsel_colmap::eval::synth::{generate, GroundTruth, SceneSpec, SyntheticScene};
-use vgsel_colmap::flow::search::{Criteria, FlowRule};
-use vgsel_colmap::selection::pipeline::{plan, Options, Plan};
+use vgsel_colmap::selection::arc_rules::Overrides;
+use vgsel_colmap::selection::parameters::Parameters;
+use vgsel_colmap::selection::pipeline::{plan, Extras, Plan};
+use vgsel_colmap::selection::preset::Preset;
 
 /// The disambiguation preset plus the general preset's pair priors at weight 0, so that one run
 /// measures every pair prior.
-fn all_priors() -> CostModel {
-    let mut model = CostModel::disambiguation();
-    for mut p in CostModel::general().pair_priors {
+fn all_priors() -> Parameters {
+    let mut parameters = Parameters::of_preset(Preset::Disambiguation);
+    for mut p in Preset::General.defaults().cost_model.pair_priors {
         p.weight = 0.0;
-        model.pair_priors.push(p);
+        parameters.cost_model.pair_priors.push(p);
     }
-    model
+    parameters
 }
 
 fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
@@ -29,24 +30,12 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
     let gt = generate(spec, &path).unwrap();
     eprintln!("generated in {:.1} s", t.elapsed().as_secs_f64());
     let db = Database::open_read_only(&path).unwrap();
-    let options = Options {
-        min_num_matches: 15,
-        rule: FlowRule::Criteria(Criteria {
-            min_image_fraction: 0.8,
-            min_pairs_per_image: 5.0,
-            min_pair_fraction: 0.0,
-            min_pairs_each: 0.0,
-        }),
-        model: all_priors(),
+    let extras = Extras {
         unweighted_priors: true,
         curve_factor: 0,
-        capture: Default::default(),
-        min_track_observations: 0,
-        min_track_length_ratio: 0.0,
-        spanning_forests: 0,
-        biconnected: false,
     };
-    let p = plan(&db, &options, &|s| eprintln!("  {s}")).unwrap();
+    let stage = |s: &str| eprintln!("  {s}");
+    let p = plan(&db, &all_priors(), &Overrides::default(), extras, &stage).unwrap();
     eprintln!("plan: {:?}", p.timings);
     let s = measure(&p, &gt);
     eprintln!("{}", s.table());

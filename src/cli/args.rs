@@ -1,13 +1,15 @@
-//! Arguments shared by several subcommands (the database, the flow rule, the preset) and the
-//! value parsers that check option values.
+//! Arguments shared by several subcommands (the database, the flow rule), the help of the
+//! options whose defaults the preset decides, and the value parsers that check option values.
 
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Duration;
 use vgsel_colmap::colmap::database::Database;
-use vgsel_colmap::flow::search::{Criteria, FlowRule, GivenCriteria};
+use vgsel_colmap::flow::search::GivenCriteria;
 use vgsel_colmap::named::Named;
+use vgsel_colmap::selection::parameters::Given;
+use vgsel_colmap::selection::preset::{Defaults, Preset};
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -28,6 +30,8 @@ impl DatabaseArg {
     }
 }
 
+/// The flow F: fixed, or searched against criteria (`prune` and `solve`). The criteria's
+/// defaults are the preset's, added to the help by [`preset_defaults`].
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
 pub struct FlowArgs {
@@ -36,105 +40,107 @@ pub struct FlowArgs {
     /// flow that keeps no pair is refused.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations", "min_track_length_ratio", "spanning_forests", "biconnected"])]
     pub flow: Option<u64>,
-    /// Search: smallest F selecting at least this fraction of the view graph's images
-    /// [default: 0.9, disambiguation preset 0.8].
+    /// Search: smallest F selecting at least this fraction of the view graph's images.
     #[arg(long, value_parser = fraction)]
     min_image_fraction: Option<f64>,
-    /// Search: ... and at least this many pairs per image (capped at all pairs)
-    /// [default: 0, disambiguation preset 5].
+    /// Search: ... and at least this many pairs per image (capped at all pairs).
     #[arg(long, value_parser = non_negative)]
     min_pairs_per_image: Option<f64>,
-    /// Search: ... and at least this fraction of the view graph's pairs
-    /// [default: 0, paper-disambiguation preset 0.25].
+    /// Search: ... and at least this fraction of the view graph's pairs.
     #[arg(long, value_parser = fraction)]
     min_pair_fraction: Option<f64>,
     /// Search: ... and every image keeps at least this many of its pairs (all it has, if
-    /// fewer) [default: 0 (off)].
+    /// fewer; 0: off).
     #[arg(long, value_parser = non_negative)]
     min_pairs_each: Option<f64>,
-    /// After the search, pairs are added until every image keeps at least this many keypoints
-    /// on feature tracks of three or more images (half of what it has, if fewer), so that the
-    /// mapper can register it [default: 100, other presets 0 (off)].
-    #[arg(long)]
-    min_track_observations: Option<usize>,
-    /// ... and until the mean length of the feature tracks is at least this share of the full
-    /// view graph's, which the cameras' accuracy depends on [default: 0.7, other presets 0 (off)].
-    #[arg(long, value_parser = fraction)]
-    min_track_length_ratio: Option<f64>,
-    /// After the search, first add this many maximum spanning forests of the view graph by
-    /// inliers (each of the pairs the ones before left), so that no part of the scene hangs on
-    /// weak pairs [default: 5, other presets 0].
-    #[arg(long)]
-    spanning_forests: Option<usize>,
-    /// Search: ... and no image cuts the selection apart: it stays connected without any one
-    /// image [default: false].
-    #[arg(long)]
-    biconnected: Option<bool>,
 }
 
 impl FlowArgs {
-    /// The flow rule, with `defaults` for unset criteria.
-    pub fn rule(&self, defaults: Criteria) -> FlowRule {
-        FlowRule::new(self.flow, self.given(), defaults)
-    }
-
-    /// The criteria as given on the command line.
-    fn given(&self) -> GivenCriteria {
-        GivenCriteria {
-            min_image_fraction: self.min_image_fraction,
-            min_pairs_per_image: self.min_pairs_per_image,
-            min_pair_fraction: self.min_pair_fraction,
-            min_pairs_each: self.min_pairs_each,
+    /// The options as given: the fixed flow, or the criteria set.
+    pub fn given(&self) -> Given {
+        Given {
+            flow: self.flow,
+            criteria: GivenCriteria {
+                min_image_fraction: self.min_image_fraction,
+                min_pairs_per_image: self.min_pairs_per_image,
+                min_pair_fraction: self.min_pair_fraction,
+                min_pairs_each: self.min_pairs_each,
+            },
+            ..Given::default()
         }
     }
+}
 
-    /// The track completion's keypoint need: None with a fixed flow, else as given or `default`.
-    pub fn track_observations(&self, default: usize) -> Option<usize> {
-        self.flow
-            .is_none()
-            .then(|| self.min_track_observations.unwrap_or(default))
-    }
+/// Appends to the help of each option whose default a preset decides (in `command` or its
+/// `prune` and `solve` subcommands) that default, read from the preset table: one value where
+/// every preset in `presets` agrees, else each one's. `solve` runs the general preset's search.
+pub fn preset_defaults(command: clap::Command) -> clap::Command {
+    command
+        .mut_subcommand("prune", |c| with_defaults(c, Preset::ALL))
+        .mut_subcommand("solve", |c| with_defaults(c, &[Preset::General]))
+}
 
-    /// The track completion's length ratio: None with a fixed flow, else as given or `default`.
-    pub fn track_length_ratio(&self, default: f64) -> Option<f64> {
-        self.flow
-            .is_none()
-            .then(|| self.min_track_length_ratio.unwrap_or(default))
-    }
-
-    /// The track completion's spanning forests: None with a fixed flow, else as given or
-    /// `default`.
-    pub fn spanning_forests(&self, default: usize) -> Option<usize> {
-        self.flow
-            .is_none()
-            .then(|| self.spanning_forests.unwrap_or(default))
-    }
-
-    /// The connectivity criterion: None with a fixed flow, else as given; off by default in
-    /// every preset, as on the scenes measured it kept more pairs and less accurate models
-    /// (docs/performance.md).
-    pub fn biconnected(&self) -> Option<bool> {
-        self.flow
-            .is_none()
-            .then(|| self.biconnected.unwrap_or(false))
-    }
-
-    /// The parameters' view of these options: the fixed flow, or the criteria filled from
-    /// `defaults`.
-    pub fn parts(&self, defaults: Criteria) -> (Option<u64>, GivenCriteria) {
-        match self.rule(defaults) {
-            FlowRule::Fixed(f) => (Some(f), GivenCriteria::default()),
-            FlowRule::Criteria(c) => (
-                None,
-                GivenCriteria {
-                    min_image_fraction: Some(c.min_image_fraction),
-                    min_pairs_per_image: Some(c.min_pairs_per_image),
-                    min_pair_fraction: Some(c.min_pair_fraction),
-                    min_pairs_each: Some(c.min_pairs_each),
-                },
-            ),
+fn with_defaults(command: clap::Command, presets: &[Preset]) -> clap::Command {
+    let rows: Vec<(Preset, Defaults)> = presets.iter().map(|&p| (p, p.defaults())).collect();
+    let per = |value: &dyn Fn(&Defaults) -> String| {
+        let values: Vec<String> = rows.iter().map(|(_, d)| value(d)).collect();
+        if values.iter().all(|v| *v == values[0]) {
+            return values[0].clone();
         }
-    }
+        let each = rows.iter().zip(&values);
+        let each: Vec<String> = each
+            .map(|((p, _), v)| format!("{} {v}", p.name()))
+            .collect();
+        each.join(", ")
+    };
+    let defaults = [
+        (
+            "min_image_fraction",
+            per(&|d| d.criteria.min_image_fraction.to_string()),
+        ),
+        (
+            "min_pairs_per_image",
+            per(&|d| d.criteria.min_pairs_per_image.to_string()),
+        ),
+        (
+            "min_pair_fraction",
+            per(&|d| d.criteria.min_pair_fraction.to_string()),
+        ),
+        (
+            "min_pairs_each",
+            per(&|d| d.criteria.min_pairs_each.to_string()),
+        ),
+        (
+            "min_track_observations",
+            per(&|d| d.completion.min_track_observations.to_string()),
+        ),
+        (
+            "min_track_length_ratio",
+            per(&|d| d.completion.min_track_length_ratio.to_string()),
+        ),
+        (
+            "spanning_forests",
+            per(&|d| d.completion.spanning_forests.to_string()),
+        ),
+        ("biconnected", per(&|d| d.biconnected.to_string())),
+        (
+            "min_pair_fitness",
+            per(&|d| d.cost_model.min_pair_fitness.to_string()),
+        ),
+    ];
+    let ids: Vec<String> = command
+        .get_arguments()
+        .map(|a| a.get_id().to_string())
+        .collect();
+    defaults
+        .into_iter()
+        .filter(|(id, _)| ids.iter().any(|i| i == id))
+        .fold(command, |command, (id, default)| {
+            command.mut_arg(id, |arg| {
+                let help = arg.get_help().map(ToString::to_string).unwrap_or_default();
+                arg.help(format!("{help} [default: {default}]"))
+            })
+        })
 }
 
 #[derive(Clone, Debug)]

@@ -29,7 +29,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "FILE", requires_all = ["database_path", "ground_truth"])]
     labels: Option<PathBuf>,
     /// A pair is used by the mapper with at least this many inliers (--Mapper.min_num_matches).
-    #[arg(long, default_value_t = vgsel_colmap::selection::pipeline::DEFAULT_MIN_NUM_MATCHES)]
+    #[arg(long, default_value_t = vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
 }
 

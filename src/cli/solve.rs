@@ -7,7 +7,7 @@ use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
 use vgsel_colmap::flow::{graph_file, search};
-use vgsel_colmap::selection::preset::Preset;
+use vgsel_colmap::selection::parameters::Parameters;
 
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
@@ -25,7 +25,9 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     let problem =
         graph_file::parse(&text).with_context(|| format!("graph {}", args.graph.display()))?;
     let started = Instant::now();
-    let result = search::search(&problem, &args.flow.rule(Preset::General.criteria()));
+    // The general preset's search, the defaults `solve --help` shows.
+    let rule = Parameters::resolve(args.flow.given())?.flow.rule();
+    let result = search::search(&problem, &rule);
     let solve_seconds = started.elapsed().as_secs_f64();
     let selection = &result.selection;
     let value = serde_json::json!({

@@ -30,34 +30,12 @@ use crate::solver::ParametricSolver;
 use serde::Serialize;
 
 /// How F is chosen: given, or the smallest F whose selection meets the criteria.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FlowRule {
     /// This F exactly.
     Fixed(u64),
     /// The smallest F that meets these coverage criteria.
     Criteria(Criteria),
-}
-
-impl FlowRule {
-    /// A fixed flow when `flow` is set, else the criteria `given`, each taken from `defaults`
-    /// where unset.
-    pub fn new(flow: Option<u64>, given: GivenCriteria, defaults: Criteria) -> FlowRule {
-        match flow {
-            Some(f) => FlowRule::Fixed(f),
-            None => FlowRule::Criteria(Criteria {
-                min_image_fraction: given
-                    .min_image_fraction
-                    .unwrap_or(defaults.min_image_fraction),
-                min_pairs_per_image: given
-                    .min_pairs_per_image
-                    .unwrap_or(defaults.min_pairs_per_image),
-                min_pair_fraction: given
-                    .min_pair_fraction
-                    .unwrap_or(defaults.min_pair_fraction),
-                min_pairs_each: given.min_pairs_each.unwrap_or(defaults.min_pairs_each),
-            }),
-        }
-    }
 }
 
 /// Criteria as a user may give them: any of them unset.
@@ -73,8 +51,24 @@ pub struct GivenCriteria {
     pub min_pairs_each: Option<f64>,
 }
 
+impl GivenCriteria {
+    /// The criteria given, each taken from `defaults` where unset.
+    pub fn or(self, defaults: Criteria) -> Criteria {
+        Criteria {
+            min_image_fraction: self
+                .min_image_fraction
+                .unwrap_or(defaults.min_image_fraction),
+            min_pairs_per_image: self
+                .min_pairs_per_image
+                .unwrap_or(defaults.min_pairs_per_image),
+            min_pair_fraction: self.min_pair_fraction.unwrap_or(defaults.min_pair_fraction),
+            min_pairs_each: self.min_pairs_each.unwrap_or(defaults.min_pairs_each),
+        }
+    }
+}
+
 /// Coverage a selection must reach: the smallest F that reaches it is chosen.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Criteria {
     /// Selected images / images in the view graph.
     pub min_image_fraction: f64,

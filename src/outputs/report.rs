@@ -3,7 +3,7 @@
 use crate::flow::search::CriterionStatus;
 use crate::named::Named;
 use crate::scene::view_graph::{GraphStats, ViewGraph};
-use crate::selection::overrides::Listed;
+use crate::selection::arc_rules::Listed;
 use crate::selection::parameters::Parameters;
 use crate::selection::pipeline::{Plan, Timings};
 use crate::selection::track_completion::Completion;
@@ -213,8 +213,8 @@ impl Report {
                 view_graph_within_window: share(None),
                 window,
                 images_without_time: order.images_without_time,
-                sequence_window: parameters.sequence_window,
-                keep_neighbours: parameters.keep_neighbours,
+                sequence_window: parameters.capture.sequence_window,
+                keep_neighbours: parameters.arc_rules.keep_neighbours,
                 neighbours_kept: plan.neighbours_kept,
             },
             outputs: Outputs::default(),

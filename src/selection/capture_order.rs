@@ -71,7 +71,7 @@ impl Named for Order {
 }
 
 /// What `prune` is told about the order.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Input {
     /// The order asked for.
     pub order: Order,
@@ -80,9 +80,6 @@ pub struct Input {
     /// The order is a capture sequence in which images at most this many positions apart see
     /// the same things (`--sequence_window`); 0: it says nothing about overlap.
     pub sequence_window: u32,
-    /// Every view-graph pair of images at most this many positions apart is kept whatever the
-    /// flow selects (`--keep_neighbours`); 0: none.
-    pub keep_neighbours: u32,
 }
 
 /// The order as computed: each view-graph vertex's position.

@@ -1,8 +1,9 @@
-//! From a database to a selection: the presets, the run's typed parameters, user overrides, and
-//! the pipeline that reads the database once, computes priors and costs, and runs the flow search.
+//! From a database to a selection: the preset table, the run's parameters resolved once, the
+//! capture order, the arc rules (overrides, close neighbours, the fitness floor), the track
+//! completion, and the pipeline that runs them as stages.
 
+pub mod arc_rules;
 pub mod capture_order;
-pub mod overrides;
 pub mod parameters;
 pub mod pipeline;
 pub mod preset;

@@ -1,129 +1,388 @@
-//! A prune's parameters as one typed record: what the selection ran with. `prune` stores it in
-//! the database's run record (`vgsel_runs.parameters`, [`crate::colmap::rewrite::RunRecord`]) and
-//! `export` reads it back to recompute the very costs that drove the selection.
+//! A prune's parameters, resolved once. The command line fills [`Given`], where every option
+//! the user can leave out is optional; [`Parameters::resolve`] fills the rest from the preset
+//! table ([`crate::selection::preset`]) into one typed record, nested by the pipeline's stages:
+//! the cost model, the flow (fixed, or searched with its criteria and track completion), the
+//! capture order and the arc rules. Each stage reads its own part. `prune` stores the record
+//! in the database's run record (`vgsel_runs.parameters`, [`crate::colmap::rewrite::RunRecord`])
+//! and `export` reads it back to recompute the very costs that drove the selection.
 
 use crate::costs::CostModel;
-use crate::flow::search::{FlowRule, GivenCriteria};
+use crate::flow::search::{Criteria, FlowRule, GivenCriteria};
+use crate::named::Named;
+use crate::priors::Prior;
+use crate::selection::arc_rules::{ArcRules, NameList, Overrides};
 use crate::selection::capture_order::{self, Order};
-use crate::selection::pipeline::Options;
 use crate::selection::preset::Preset;
+use crate::selection::track_completion::Needs;
+use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// COLMAP's default `--Mapper.min_num_matches`: fewer verified inliers make no view-graph edge.
+pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;
+
+/// A prune's options as the user gave them; `None` (or empty) takes the default.
+#[derive(Clone, Debug, Default)]
+pub struct Given {
+    /// `--preset` (general).
+    pub preset: Option<Preset>,
+    /// `--min_num_matches` ([`DEFAULT_MIN_NUM_MATCHES`]).
+    pub min_num_matches: Option<usize>,
+    /// `--flow`: a fixed F instead of the search.
+    pub flow: Option<u64>,
+    /// The search criteria given (the preset's where unset).
+    pub criteria: GivenCriteria,
+    /// `--min_track_observations` (the preset's).
+    pub min_track_observations: Option<usize>,
+    /// `--min_track_length_ratio` (the preset's).
+    pub min_track_length_ratio: Option<f64>,
+    /// `--spanning_forests` (the preset's).
+    pub spanning_forests: Option<usize>,
+    /// `--biconnected` (the preset's).
+    pub biconnected: Option<bool>,
+    /// `--weights`: prior names and weights replacing the preset's.
+    pub weights: Vec<(String, f64)>,
+    /// `--min_pair_fitness` (the preset's).
+    pub min_pair_fitness: Option<f64>,
+    /// `--order` (image_id).
+    pub order: Option<Order>,
+    /// `--image_path`, for the exif order.
+    pub image_path: Option<PathBuf>,
+    /// `--sequence_window` (0: none).
+    pub sequence_window: Option<u32>,
+    /// `--keep_neighbours` (0: none).
+    pub keep_neighbours: Option<u32>,
+    /// `--keep_pairs`.
+    pub keep_pairs: Option<PathBuf>,
+    /// `--forbid_pairs`.
+    pub forbid_pairs: Option<PathBuf>,
+    /// `--forbid_images`.
+    pub forbid_images: Option<PathBuf>,
+}
 
 /// Everything that decides a selection, besides the database.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(into = "Recorded", from = "Recorded")]
 pub struct Parameters {
     /// The preset named.
     pub preset: Preset,
-    /// The cost model used: the preset's, with any weight and fitness-floor overrides applied.
-    pub cost_model: CostModel,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
     pub min_num_matches: usize,
-    /// The flow F when it was fixed; None when it was searched.
-    pub flow: Option<u64>,
-    /// The search's image criterion (None with a fixed flow).
-    pub min_image_fraction: Option<f64>,
-    /// The search's pair criterion (None with a fixed flow).
-    pub min_pairs_per_image: Option<f64>,
-    /// The search's share-of-pairs criterion (None with a fixed flow or in older records).
-    #[serde(default)]
-    pub min_pair_fraction: Option<f64>,
-    /// The search's per-image criterion (None with a fixed flow or in older records).
-    #[serde(default)]
-    pub min_pairs_each: Option<f64>,
-    /// The track completion: keypoints every image keeps on tracks of three or more
-    /// observations (None with a fixed flow or in older records, where it did not exist: off).
-    #[serde(default)]
-    pub min_track_observations: Option<usize>,
-    /// The track completion's share of the full graph's mean track length (None with a fixed
-    /// flow or in older records: off).
-    #[serde(default)]
-    pub min_track_length_ratio: Option<f64>,
-    /// Maximum spanning forests by inliers the track completion keeps (None with a fixed flow
-    /// or in older records: none).
-    #[serde(default)]
-    pub spanning_forests: Option<usize>,
-    /// The search's connectivity criterion: no cut image in the selection (None with a fixed
-    /// flow or in older records: off).
-    #[serde(default)]
-    pub biconnected: Option<bool>,
-    /// The order the network's pair arcs follow (image_id in older records).
-    #[serde(default)]
-    pub order: Order,
-    /// The image folder read for the `exif` order.
-    #[serde(default)]
-    pub image_path: Option<String>,
-    /// Images at most this many positions apart in `order` are neighbours in a capture
-    /// sequence (0, and in older records: the order says nothing about overlap).
-    #[serde(default)]
-    pub sequence_window: u32,
-    /// Pairs of images at most this many positions apart in `order` were kept whatever the
-    /// flow selected (0, and in older records: none).
-    #[serde(default)]
-    pub keep_neighbours: u32,
-    /// The override files given (paths as given), for the record.
-    pub keep_pairs: Option<String>,
-    /// See `keep_pairs`.
-    pub forbid_pairs: Option<String>,
-    /// See `keep_pairs`.
-    pub forbid_images: Option<String>,
+    /// The cost model: the preset's, with the weight and fitness-floor changes applied.
+    pub cost_model: CostModel,
+    /// How the flow F is chosen, and what follows a search.
+    pub flow: Flow,
+    /// The order the network's pair arcs follow, and whether it is a capture sequence.
+    pub capture: capture_order::Input,
+    /// Which arcs are fixed or removed before the flow runs, besides the fitness floor.
+    pub arc_rules: ArcRules,
+}
+
+/// How F is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Flow {
+    /// This F exactly: no criteria, no completion.
+    Fixed(u64),
+    /// The smallest F meeting the criteria, then the track completion.
+    Searched(Search),
+}
+
+/// A searched flow's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Search {
+    /// What the selection must reach.
+    pub criteria: Criteria,
+    /// Also keep the selection free of cut images.
+    pub biconnected: bool,
+    /// Pairs added after the search.
+    pub completion: Needs,
+}
+
+impl Flow {
+    /// The flow crate's view: the fixed F or the criteria.
+    pub fn rule(&self) -> FlowRule {
+        match self {
+            Flow::Fixed(f) => FlowRule::Fixed(*f),
+            Flow::Searched(s) => FlowRule::Criteria(s.criteria),
+        }
+    }
 }
 
 impl Parameters {
-    /// A preset's parameters: its cost model and search criteria, no overrides.
-    pub fn of_preset(preset: Preset, min_num_matches: usize) -> Parameters {
-        let c = preset.criteria();
-        Parameters {
+    /// Fills what `given` leaves unset from the preset table. Errors: a weight for a prior the
+    /// preset does not have, or a sequence window without the prior it shapes.
+    pub fn resolve(given: Given) -> Result<Parameters> {
+        let preset = given.preset.unwrap_or(Preset::General);
+        let defaults = preset.defaults();
+        let mut cost_model = defaults.cost_model;
+        for (name, w) in &given.weights {
+            cost_model.set_weight(name, *w)?;
+        }
+        if let Some(floor) = given.min_pair_fitness {
+            cost_model.min_pair_fitness = floor;
+        }
+        let sequence_window = given.sequence_window.unwrap_or(0);
+        if sequence_window > 0
+            && !cost_model
+                .pair_priors_to_compute(false)
+                .contains(&Prior::BackboneTracks)
+        {
+            bail!(
+                "--sequence_window shapes the backbone_tracks prior, which --preset {} does not weigh (use --preset disambiguation, or give it a weight with --weights)",
+                preset.name()
+            );
+        }
+        let flow = match given.flow {
+            Some(f) => Flow::Fixed(f),
+            None => Flow::Searched(Search {
+                criteria: given.criteria.or(defaults.criteria),
+                biconnected: given.biconnected.unwrap_or(defaults.biconnected),
+                completion: Needs {
+                    spanning_forests: given
+                        .spanning_forests
+                        .unwrap_or(defaults.completion.spanning_forests),
+                    min_track_observations: given
+                        .min_track_observations
+                        .unwrap_or(defaults.completion.min_track_observations),
+                    min_track_length_ratio: given
+                        .min_track_length_ratio
+                        .unwrap_or(defaults.completion.min_track_length_ratio),
+                },
+            }),
+        };
+        Ok(Parameters {
             preset,
-            cost_model: preset.model(),
-            min_num_matches,
-            flow: None,
-            min_image_fraction: Some(c.min_image_fraction),
-            min_pairs_per_image: Some(c.min_pairs_per_image),
-            min_pair_fraction: Some(c.min_pair_fraction),
-            min_pairs_each: Some(c.min_pairs_each),
-            min_track_observations: Some(preset.min_track_observations()),
-            min_track_length_ratio: Some(preset.min_track_length_ratio()),
-            spanning_forests: Some(preset.spanning_forests()),
-            biconnected: Some(false),
-            order: Order::default(),
-            image_path: None,
-            sequence_window: 0,
-            keep_neighbours: 0,
-            keep_pairs: None,
-            forbid_pairs: None,
-            forbid_images: None,
+            min_num_matches: given.min_num_matches.unwrap_or(DEFAULT_MIN_NUM_MATCHES),
+            cost_model,
+            flow,
+            capture: capture_order::Input {
+                order: given.order.unwrap_or_default(),
+                image_path: given.image_path,
+                sequence_window,
+            },
+            arc_rules: ArcRules {
+                keep_neighbours: given.keep_neighbours.unwrap_or(0),
+                keep_pairs: given.keep_pairs,
+                forbid_pairs: given.forbid_pairs,
+                forbid_images: given.forbid_images,
+            },
+        })
+    }
+
+    /// A preset's parameters, nothing changed.
+    pub fn of_preset(preset: Preset) -> Parameters {
+        let given = Given {
+            preset: Some(preset),
+            ..Given::default()
+        };
+        Parameters::resolve(given).expect("a preset's own parameters resolve")
+    }
+
+    /// The override files named in `arc_rules`, read.
+    pub fn read_overrides(&self) -> Result<Overrides> {
+        let read = |path: &Option<PathBuf>, pairs| {
+            path.as_deref()
+                .map(|p| NameList::read(p, pairs))
+                .transpose()
+        };
+        let rules = &self.arc_rules;
+        Ok(Overrides {
+            keep_pairs: read(&rules.keep_pairs, true)?,
+            forbid_pairs: read(&rules.forbid_pairs, true)?,
+            forbid_images: read(&rules.forbid_images, false)?,
+        })
+    }
+}
+
+/// The run record's layout (`vgsel_runs.parameters`, the report's `parameters`): flat, as every
+/// version wrote it. Fields added since default so that older records still load, with what
+/// the run then did (off, image_id order) or, for search criteria, the preset's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct Recorded {
+    preset: Preset,
+    cost_model: CostModel,
+    min_num_matches: usize,
+    flow: Option<u64>,
+    min_image_fraction: Option<f64>,
+    min_pairs_per_image: Option<f64>,
+    #[serde(default)]
+    min_pair_fraction: Option<f64>,
+    #[serde(default)]
+    min_pairs_each: Option<f64>,
+    #[serde(default)]
+    min_track_observations: Option<usize>,
+    #[serde(default)]
+    min_track_length_ratio: Option<f64>,
+    #[serde(default)]
+    spanning_forests: Option<usize>,
+    #[serde(default)]
+    biconnected: Option<bool>,
+    #[serde(default)]
+    order: Order,
+    #[serde(default)]
+    image_path: Option<String>,
+    #[serde(default)]
+    sequence_window: u32,
+    #[serde(default)]
+    keep_neighbours: u32,
+    keep_pairs: Option<String>,
+    forbid_pairs: Option<String>,
+    forbid_images: Option<String>,
+}
+
+impl From<Parameters> for Recorded {
+    fn from(p: Parameters) -> Recorded {
+        let search = match p.flow {
+            Flow::Fixed(_) => None,
+            Flow::Searched(s) => Some(s),
+        };
+        let text = |path: Option<PathBuf>| path.map(|p| p.display().to_string());
+        Recorded {
+            preset: p.preset,
+            cost_model: p.cost_model,
+            min_num_matches: p.min_num_matches,
+            flow: match p.flow {
+                Flow::Fixed(f) => Some(f),
+                Flow::Searched(_) => None,
+            },
+            min_image_fraction: search.map(|s| s.criteria.min_image_fraction),
+            min_pairs_per_image: search.map(|s| s.criteria.min_pairs_per_image),
+            min_pair_fraction: search.map(|s| s.criteria.min_pair_fraction),
+            min_pairs_each: search.map(|s| s.criteria.min_pairs_each),
+            min_track_observations: search.map(|s| s.completion.min_track_observations),
+            min_track_length_ratio: search.map(|s| s.completion.min_track_length_ratio),
+            spanning_forests: search.map(|s| s.completion.spanning_forests),
+            biconnected: search.map(|s| s.biconnected),
+            order: p.capture.order,
+            image_path: text(p.capture.image_path),
+            sequence_window: p.capture.sequence_window,
+            keep_neighbours: p.arc_rules.keep_neighbours,
+            keep_pairs: text(p.arc_rules.keep_pairs),
+            forbid_pairs: text(p.arc_rules.forbid_pairs),
+            forbid_images: text(p.arc_rules.forbid_images),
         }
     }
+}
 
-    /// The flow rule: the fixed F, or the search criteria (the preset's where unset).
-    pub fn rule(&self) -> FlowRule {
+impl From<Recorded> for Parameters {
+    fn from(r: Recorded) -> Parameters {
         let given = GivenCriteria {
-            min_image_fraction: self.min_image_fraction,
-            min_pairs_per_image: self.min_pairs_per_image,
-            min_pair_fraction: self.min_pair_fraction,
-            min_pairs_each: self.min_pairs_each,
+            min_image_fraction: r.min_image_fraction,
+            min_pairs_per_image: r.min_pairs_per_image,
+            min_pair_fraction: r.min_pair_fraction,
+            min_pairs_each: r.min_pairs_each,
         };
-        FlowRule::new(self.flow, given, self.preset.criteria())
-    }
-
-    /// The pipeline's options; `unweighted_priors` also computes the priors of weight 0.
-    pub fn options(&self, unweighted_priors: bool) -> Options {
-        Options {
-            min_num_matches: self.min_num_matches,
-            rule: self.rule(),
-            min_track_observations: self.min_track_observations.unwrap_or(0),
-            min_track_length_ratio: self.min_track_length_ratio.unwrap_or(0.0),
-            spanning_forests: self.spanning_forests.unwrap_or(0),
-            biconnected: self.biconnected.unwrap_or(false),
-            model: self.cost_model.clone(),
-            unweighted_priors,
-            curve_factor: 0,
+        let flow = match r.flow {
+            Some(f) => Flow::Fixed(f),
+            None => Flow::Searched(Search {
+                criteria: given.or(r.preset.defaults().criteria),
+                biconnected: r.biconnected.unwrap_or(false),
+                completion: Needs {
+                    spanning_forests: r.spanning_forests.unwrap_or(0),
+                    min_track_observations: r.min_track_observations.unwrap_or(0),
+                    min_track_length_ratio: r.min_track_length_ratio.unwrap_or(0.0),
+                },
+            }),
+        };
+        Parameters {
+            preset: r.preset,
+            min_num_matches: r.min_num_matches,
+            cost_model: r.cost_model,
+            flow,
             capture: capture_order::Input {
-                order: self.order,
-                image_path: self.image_path.as_ref().map(Into::into),
-                sequence_window: self.sequence_window,
-                keep_neighbours: self.keep_neighbours,
+                order: r.order,
+                image_path: r.image_path.map(PathBuf::from),
+                sequence_window: r.sequence_window,
+            },
+            arc_rules: ArcRules {
+                keep_neighbours: r.keep_neighbours,
+                keep_pairs: r.keep_pairs.map(PathBuf::from),
+                forbid_pairs: r.forbid_pairs.map(PathBuf::from),
+                forbid_images: r.forbid_images.map(PathBuf::from),
             },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Records as earlier versions wrote them (fixtures/runs, written by the binary of
+    /// 949127d; `general-oldest` without every field added since the first release) load, and
+    /// a record written today reads back as the same parameters and the same fields.
+    #[test]
+    fn earlier_run_records_load() {
+        let fixture = |name: &str| {
+            let path = format!("{}/fixtures/runs/{name}.json", env!("CARGO_MANIFEST_DIR"));
+            std::fs::read_to_string(path).unwrap()
+        };
+        let sequence: Parameters =
+            serde_json::from_str(&fixture("disambiguation-sequence")).unwrap();
+        assert_eq!(sequence.capture.order, Order::Name);
+        assert_eq!(sequence.capture.sequence_window, 3);
+        assert_eq!(sequence.arc_rules.keep_neighbours, 2);
+        let Flow::Searched(search) = sequence.flow else {
+            panic!("a searched flow")
+        };
+        assert_eq!(search.criteria, Preset::Disambiguation.defaults().criteria);
+        let fixed: Parameters = serde_json::from_str(&fixture("general-fixed-flow")).unwrap();
+        assert_eq!(fixed.flow, Flow::Fixed(30));
+        assert_eq!(fixed.min_num_matches, 20);
+        let homography = fixed.cost_model.pair_priors.iter();
+        let homography = homography.filter(|p| p.prior == Prior::Homography);
+        assert_eq!(homography.map(|p| p.weight).collect::<Vec<_>>(), [0.5]);
+        for name in ["disambiguation-sequence", "general-fixed-flow"] {
+            let recorded: serde_json::Value = serde_json::from_str(&fixture(name)).unwrap();
+            let parameters: Parameters = serde_json::from_value(recorded.clone()).unwrap();
+            assert_eq!(serde_json::to_value(&parameters).unwrap(), recorded);
+        }
+        // The oldest layout: no completion, no connectivity criterion, image_id order.
+        let oldest: Parameters = serde_json::from_str(&fixture("general-oldest")).unwrap();
+        let expected = Search {
+            criteria: Preset::General.defaults().criteria,
+            biconnected: false,
+            completion: Needs::OFF,
+        };
+        assert_eq!(oldest.flow, Flow::Searched(expected));
+        assert_eq!(oldest.capture, capture_order::Input::default());
+        assert_eq!(oldest.cost_model, Preset::General.defaults().cost_model);
+    }
+
+    /// The preset fills exactly what the user left unset.
+    #[test]
+    fn given_options_win_over_the_preset() {
+        let given = Given {
+            preset: Some(Preset::Disambiguation),
+            criteria: GivenCriteria {
+                min_pairs_per_image: Some(2.0),
+                ..GivenCriteria::default()
+            },
+            min_track_observations: Some(40),
+            min_pair_fitness: Some(0.3),
+            weights: vec![("unique_tracks".into(), 0.5)],
+            ..Given::default()
+        };
+        let p = Parameters::resolve(given).unwrap();
+        let Flow::Searched(search) = p.flow else {
+            panic!("a searched flow")
+        };
+        assert_eq!(search.criteria.min_pairs_per_image, 2.0);
+        assert_eq!(search.criteria.min_image_fraction, 0.8);
+        assert_eq!(search.completion.min_track_observations, 40);
+        assert_eq!(search.completion.spanning_forests, 0);
+        assert_eq!(p.cost_model.min_pair_fitness, 0.3);
+        assert_eq!(p.cost_model.pair_priors_to_compute(false).len(), 2);
+        let unknown = Given {
+            weights: vec![("nope".into(), 1.0)],
+            ..Given::default()
+        };
+        assert!(Parameters::resolve(unknown).is_err());
+        let window_without_backbone = Given {
+            sequence_window: Some(3),
+            ..Given::default()
+        };
+        let error = Parameters::resolve(window_without_backbone).unwrap_err();
+        assert!(error.to_string().contains("--preset general"), "{error}");
     }
 }

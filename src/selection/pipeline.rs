@@ -1,57 +1,40 @@
-//! The prune pipeline up to the selection: read the database, build the view graph, compute the
-//! priors and costs, run the flow search. It writes nothing; [`crate::colmap::rewrite`] applies the plan.
+//! The prune pipeline up to the selection, in six stages: (1) load what the database holds and
+//! the priors need, (2) compute the priors, (3) turn them into costs, (4) apply the arc rules
+//! (overrides, close neighbours, the fitness floor), (5) search the flow, (6) complete the
+//! feature tracks. [`plan`] runs them in that order; it writes nothing:
+//! [`crate::colmap::rewrite`] applies the plan.
 
 use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, VerifiedPair};
 use crate::colmap::ids::pair_id;
 use crate::colmap::rewrite;
-use crate::costs::{self, CostModel, Costs};
+use crate::costs::{self, Costs};
 use crate::flow::connectivity::Biconnected;
-use crate::flow::network::{ArcRule, PairArc, Restriction, SelectionProblem};
-use crate::flow::search::{self, FlowRule, SearchResult, SelectionCheck};
+use crate::flow::network::{PairArc, Restriction, SelectionProblem};
+use crate::flow::search::{self, SearchResult, SelectionCheck};
 use crate::geometry::camera::CameraModel;
 use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::{Scene, Sequence};
+use crate::selection::arc_rules::{self, ArcRules, Listed, Overrides};
 use crate::selection::capture_order::{self, CaptureOrder};
-use crate::selection::overrides::{Listed, Overrides};
-use crate::selection::parameters::Parameters;
+use crate::selection::parameters::{Flow, Parameters};
 use crate::selection::preset::Preset;
-use crate::selection::track_completion::{self, Completion, Needs};
+use crate::selection::track_completion::{self, Completion};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::collections::HashMap;
 use std::time::Instant;
 
-/// COLMAP's default `--Mapper.min_num_matches`: fewer verified inliers make no view-graph edge.
-pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;
-
-/// What the pipeline runs with (built from [`crate::selection::parameters::Parameters`]).
-pub struct Options {
-    /// A pair is a view-graph edge when it has at least this many verified inliers.
-    pub min_num_matches: usize,
-    /// How the flow F is chosen: fixed, or searched against the image and pair criteria.
-    pub rule: FlowRule,
-    /// After a criteria search, pairs are added until every image keeps this many keypoints on
-    /// feature tracks of three or more observations ([`track_completion`]); 0: off.
-    pub min_track_observations: usize,
-    /// ... after adding this many maximum spanning forests by inliers ...
-    pub spanning_forests: usize,
-    /// ... and until the mean track length a keypoint sees is this share of the full graph's;
-    /// 0: off.
-    pub min_track_length_ratio: f64,
-    /// A criteria search also keeps the selection free of cut images ([`Biconnected`]).
-    pub biconnected: bool,
-    /// The priors, their g and weights, and the fitness floor that make the arc costs.
-    pub model: CostModel,
-    /// Also compute the model's priors of weight 0 (they do not change the costs): for
-    /// `--scores`. Otherwise they are skipped, which matters at scale (multiple motions run a
-    /// RANSAC per pair).
+/// What the outputs want of a plan beyond the selection.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Extras {
+    /// Also compute the cost model's priors of weight 0 (they do not change the costs): for
+    /// `--scores` and `export`. Otherwise they are skipped, which matters at scale (multiple
+    /// motions run a RANSAC per pair).
     pub unweighted_priors: bool,
     /// Continue the selection curve to this many times the chosen F (0: stop there), for plots.
     pub curve_factor: u64,
-    /// The order the network's pair arcs follow.
-    pub capture: capture_order::Input,
 }
 
 /// Seconds spent in each stage.
@@ -125,136 +108,75 @@ impl Plan {
     }
 }
 
-/// Reads the database and decides the selection. `stage` is told the name of each long step.
-pub fn plan(db: &Database, options: &Options, stage: &dyn Fn(&str)) -> Result<Plan> {
-    plan_with(db, options, &Overrides::default(), stage)
-}
-
-/// The plan of the database's last prune, recomputed from its recorded parameters (the general
-/// preset's when it was never pruned), without running a flow: its priors and costs are the ones
-/// that drove that selection. Which pairs were kept is the database's to say
-/// ([`crate::colmap::database::Database::invalidated_pair_ids`]).
-pub fn last_plan(db: &Database, stage: &dyn Fn(&str)) -> Result<Plan> {
-    let parameters = match rewrite::last_run::<Parameters>(db)? {
-        Some(row) => row.run.parameters,
-        None => Parameters::of_preset(Preset::General, DEFAULT_MIN_NUM_MATCHES),
-    };
-    // No flow runs, so the order, which only orients the arcs, is image_id's: it needs no image
-    // files (an EXIF order would). Unless a sequence window made the order shape the backbone
-    // and so the costs: then it is the recorded one.
-    let recorded = parameters.options(true);
-    let capture = match recorded.capture.sequence_window {
-        0 => Default::default(),
-        _ => recorded.capture.clone(),
-    };
-    let options = Options {
-        rule: FlowRule::Fixed(0),
-        capture,
-        ..recorded
-    };
-    plan_with(db, &options, &Overrides::default(), stage)
-}
-
-/// [`plan`] honouring user overrides (see [`crate::selection::overrides`]).
-pub fn plan_with(
+/// Reads the database and decides the selection with `parameters`, honouring the user's
+/// `overrides` (read from the files `parameters.arc_rules` names). `stage` is told the name of
+/// each long step.
+pub fn plan(
     db: &Database,
-    options: &Options,
+    parameters: &Parameters,
     overrides: &Overrides,
+    extras: Extras,
     stage: &dyn Fn(&str),
 ) -> Result<Plan> {
     let started = Instant::now();
     let mut timings = Timings::default();
 
+    // 1. Load: the view graph, the overrides' names checked against it, the capture order, and
+    //    what the priors read.
     stage("reading images and verified pairs");
     let data_version = db.data_version()?;
-    let images = db.images()?;
-    let cameras = db.cameras()?;
-    let pairs = db.verified_pairs()?;
-    if pairs.is_empty() {
-        bail!("no verified image pairs in two_view_geometries: run a COLMAP matcher first");
-    }
-    let graph = ViewGraph::build(&images, &pairs, options.min_num_matches);
-    if graph.edges.is_empty() {
-        bail!(
-            "no image pair has at least {} verified inliers (min_num_matches)",
-            options.min_num_matches
-        );
-    }
-    let mut resolved = overrides.resolve(&images, &graph, options.min_num_matches)?;
-    let names = options
-        .model
-        .pair_priors_to_compute(options.unweighted_priors);
-    let mut scene = load_scene(db, &graph, &pairs, &images, cameras, &names, stage)?;
-    let order = capture_order::compute(&options.capture, &graph, &images, &pairs)?;
-    let neighbours_kept = keep_neighbours(
-        &mut resolved.edges,
-        &graph,
-        &order,
-        options.capture.keep_neighbours,
-    );
-    let window = options.capture.sequence_window;
+    let Read {
+        images,
+        cameras,
+        pairs,
+        graph,
+    } = read(db, parameters.min_num_matches)?;
+    let mut rules = overrides.resolve(&images, &graph, parameters.min_num_matches)?;
+    let to_compute = (parameters.cost_model).pair_priors_to_compute(extras.unweighted_priors);
+    let mut scene = load_scene(db, &graph, &pairs, &images, cameras, &to_compute, stage)?;
+    let order = capture_order::compute(&parameters.capture, &graph, &images, &pairs)?;
+    let window = parameters.capture.sequence_window;
     scene.sequence = (window > 0).then(|| Sequence {
         rank: order.rank.clone(),
         window,
     });
     timings.read = started.elapsed().as_secs_f64();
 
+    // 2. Priors, and 3. costs.
     stage("computing priors");
     let t = Instant::now();
     let image_priors = priors::general_image_priors(&scene);
-    let pair_priors = priors::pairs::compute(&scene, &names, stage)?;
-    let costs = costs::compute(&options.model, &image_priors, &pair_priors.values);
+    let pair_priors = priors::pairs::compute(&scene, &to_compute, stage)?;
+    let costs = costs::compute(&parameters.cost_model, &image_priors, &pair_priors.values);
     timings.priors = t.elapsed().as_secs_f64();
 
+    // 4. Arc rules: close neighbours kept, pairs below the fitness floor removed.
     stage("solving the min-cost flow selection");
     let t = Instant::now();
-    let floor = fitness_floor(options, &graph, &costs.pair_costs);
-    let mut below_fitness_floor = 0;
-    for (rule, cost) in resolved.edges.iter_mut().zip(&costs.pair_costs) {
-        if *rule == ArcRule::Free && -cost < floor {
-            *rule = ArcRule::Removed;
-            below_fitness_floor += 1;
-        }
-    }
-    let network = problem(&graph, &costs, &order).restrict(
-        &order.by_rank(&resolved.forbidden_vertices),
-        &resolved.edges,
+    let rule = parameters.flow.rule();
+    let neighbours_kept = arc_rules::keep_neighbours(
+        &mut rules.edges,
+        &graph,
+        &order,
+        parameters.arc_rules.keep_neighbours,
     );
-    let searched = matches!(options.rule, FlowRule::Criteria(_));
-    let biconnected = (searched && options.biconnected).then(|| Biconnected::new(&network.problem));
-    let mut checks: Vec<&dyn SelectionCheck> = Vec::new();
-    if let Some(b) = &biconnected {
-        checks.push(b);
-    }
-    let mut search = search::search_with_curve(
-        &network.problem,
-        &options.rule,
-        options.curve_factor,
-        &checks,
+    let min_pair_fitness = parameters.cost_model.min_pair_fitness;
+    let floor = arc_rules::fitness_floor(min_pair_fitness, &rule, &graph, &costs.pair_costs);
+    let below_fitness_floor =
+        arc_rules::remove_below_floor(&mut rules.edges, &costs.pair_costs, floor);
+    let network = problem(&graph, &costs, &order)
+        .restrict(&order.by_rank(&rules.forbidden_vertices), &rules.edges);
+
+    // 5. The flow search, and 6. the track completion.
+    let mut search = search_flow(&network, &parameters.flow, extras.curve_factor, &order);
+    let completion = complete_tracks(
+        &scene,
+        &network,
+        &graph,
+        &mut search,
+        &parameters.flow,
+        stage,
     );
-    search.selection = network.expand(&search.selection);
-    search.selection.images = order.by_vertex(&search.selection.images);
-    let needs = Needs {
-        spanning_forests: options.spanning_forests,
-        min_track_observations: options.min_track_observations,
-        min_track_length_ratio: options.min_track_length_ratio,
-    };
-    // A capped search kept everything already.
-    let completion = (searched && !search.capped && needs.any()).then(|| {
-        stage("completing feature tracks");
-        let done =
-            track_completion::complete(&scene, &network, &mut search.selection.pairs, &needs);
-        for (e, _) in graph
-            .edges
-            .iter()
-            .zip(&search.selection.pairs)
-            .filter(|(_, &k)| k)
-        {
-            search.selection.images[e.i as usize] = true;
-            search.selection.images[e.j as usize] = true;
-        }
-        done
-    });
     timings.solve = t.elapsed().as_secs_f64();
 
     let invalidate = graph
@@ -274,7 +196,7 @@ pub fn plan_with(
         focal_estimates: pair_priors.focal_estimates,
         costs,
         network,
-        overrides: resolved.listed,
+        overrides: rules.listed,
         neighbours_kept,
         order,
         search,
@@ -287,28 +209,121 @@ pub fn plan_with(
     })
 }
 
-/// Fixes every free edge whose images are at most `window` positions apart in `order`, so the
-/// pair is kept whatever the flow selects; forbidden pairs stay forbidden. Returns how many.
-/// Why: in a capture known to be a sequence, close neighbours see the same things, so their
-/// verified pairs are true, and keeping them all gives a walk between look-alike objects the
-/// redundancy a mapper needs to cross it in one piece (docs/cli.md).
-fn keep_neighbours(
-    rules: &mut [ArcRule],
-    graph: &ViewGraph,
+/// The plan of the database's last prune, recomputed from its recorded parameters (the general
+/// preset's when it was never pruned), without running a flow: its priors and costs are the ones
+/// that drove that selection. Which pairs were kept is the database's to say
+/// ([`crate::colmap::database::Database::invalidated_pair_ids`]).
+pub fn last_plan(db: &Database, stage: &dyn Fn(&str)) -> Result<Plan> {
+    let recorded = match rewrite::last_run::<Parameters>(db)? {
+        Some(row) => row.run.parameters,
+        None => Parameters::of_preset(Preset::General),
+    };
+    // No flow runs, so the order, which only orients the arcs, is image_id's: it needs no image
+    // files (an EXIF order would). Unless a sequence window made the order shape the backbone
+    // and so the costs: then it is the recorded one, with its close neighbours.
+    let sequence = recorded.capture.sequence_window > 0;
+    let parameters = Parameters {
+        flow: Flow::Fixed(0),
+        capture: if sequence {
+            recorded.capture.clone()
+        } else {
+            Default::default()
+        },
+        arc_rules: ArcRules {
+            keep_neighbours: if sequence {
+                recorded.arc_rules.keep_neighbours
+            } else {
+                0
+            },
+            ..ArcRules::default()
+        },
+        ..recorded
+    };
+    let extras = Extras {
+        unweighted_priors: true,
+        curve_factor: 0,
+    };
+    plan(db, &parameters, &Overrides::default(), extras, stage)
+}
+
+/// What [`read`] returns: the database's images, cameras and verified pairs, and their view
+/// graph.
+struct Read {
+    images: Vec<Image>,
+    cameras: Vec<Camera>,
+    pairs: Vec<VerifiedPair>,
+    graph: ViewGraph,
+}
+
+/// Stage 1's first step: the rows every prune needs, and the view graph of pairs with at least
+/// `min_num_matches` inliers; refuses a database without one.
+fn read(db: &Database, min_num_matches: usize) -> Result<Read> {
+    let images = db.images()?;
+    let cameras = db.cameras()?;
+    let pairs = db.verified_pairs()?;
+    if pairs.is_empty() {
+        bail!("no verified image pairs in two_view_geometries: run a COLMAP matcher first");
+    }
+    let graph = ViewGraph::build(&images, &pairs, min_num_matches);
+    if graph.edges.is_empty() {
+        bail!("no image pair has at least {min_num_matches} verified inliers (min_num_matches)");
+    }
+    Ok(Read {
+        images,
+        cameras,
+        pairs,
+        graph,
+    })
+}
+
+/// Stage 5: the flow search on the network, its selection mapped back to the whole view graph
+/// (kept pairs added, images by vertex).
+fn search_flow(
+    network: &Restriction,
+    flow: &Flow,
+    curve_factor: u64,
     order: &CaptureOrder,
-    window: u32,
-) -> usize {
-    if window == 0 {
-        return 0;
+) -> SearchResult {
+    let biconnected = match flow {
+        Flow::Searched(s) if s.biconnected => Some(Biconnected::new(&network.problem)),
+        _ => None,
+    };
+    let mut checks: Vec<&dyn SelectionCheck> = Vec::new();
+    if let Some(b) = &biconnected {
+        checks.push(b);
     }
-    let mut kept = 0;
-    for (rule, e) in rules.iter_mut().zip(&graph.edges) {
-        if *rule == ArcRule::Free && order.within(e.i, e.j, window) {
-            *rule = ArcRule::Fixed;
-            kept += 1;
-        }
+    let mut search =
+        search::search_with_curve(&network.problem, &flow.rule(), curve_factor, &checks);
+    search.selection = network.expand(&search.selection);
+    search.selection.images = order.by_vertex(&search.selection.images);
+    search
+}
+
+/// Stage 6: after a search, the track completion adds the pairs the feature tracks need (none
+/// after a fixed flow, or a capped search, which kept everything already).
+fn complete_tracks(
+    scene: &Scene,
+    network: &Restriction,
+    graph: &ViewGraph,
+    search: &mut SearchResult,
+    flow: &Flow,
+    stage: &dyn Fn(&str),
+) -> Option<Completion> {
+    let Flow::Searched(settings) = flow else {
+        return None;
+    };
+    if search.capped || !settings.completion.any() {
+        return None;
     }
-    kept
+    stage("completing feature tracks");
+    let selection = &mut search.selection;
+    let done =
+        track_completion::complete(scene, network, &mut selection.pairs, &settings.completion);
+    for (e, _) in graph.edges.iter().zip(&selection.pairs).filter(|(_, &k)| k) {
+        selection.images[e.i as usize] = true;
+        selection.images[e.j as usize] = true;
+    }
+    Some(done)
 }
 
 /// The paper's network on the whole view graph: images indexed by their position in `order`
@@ -341,7 +356,7 @@ fn load_scene<'a>(
     pairs: &'a [VerifiedPair],
     images: &[Image],
     cameras: Vec<Camera>,
-    names: &[Prior],
+    priors_to_compute: &[Prior],
     stage: &dyn Fn(&str),
 ) -> Result<Scene<'a>> {
     let camera_of: HashMap<u32, u32> = images
@@ -378,7 +393,7 @@ fn load_scene<'a>(
         .map(|&id| db.keypoints_xy(id))
         .collect::<Result<Vec<_>>>()?;
     let mut scene = Scene::new(graph, pairs, keypoints, image_sizes);
-    let needs = priors::pairs::needs(names);
+    let needs = priors::pairs::needs(priors_to_compute);
     if needs.geometry {
         scene.cameras = cameras
             .into_iter()
@@ -407,44 +422,10 @@ fn load_scene<'a>(
     Ok(scene)
 }
 
-/// The cost model's `min_pair_fitness`, lowered where needed so that the image criterion's
-/// share of images keep a pair above it, and at least half as many pairs as the pair criterion
-/// asks for reach it. On scenes where the priors score every pair low (real photos where few
-/// triangles close within the loop tolerance) a fixed floor left the flow too few pairs for
-/// `colmap mapper` to start a model (docs/priors.md). With a fixed flow it is applied as given.
-pub fn fitness_floor(options: &Options, graph: &ViewGraph, pair_costs: &[f64]) -> f64 {
-    let floor = options.model.min_pair_fitness;
-    let FlowRule::Criteria(criteria) = &options.rule else {
-        return floor;
-    };
-    let n = graph.num_vertices();
-    if floor <= 0.0 || n == 0 {
-        return floor;
-    }
-    // The k-th largest of some values (k >= 1, at most their count).
-    let kth = |mut values: Vec<f64>, k: usize| {
-        let k = k.clamp(1, values.len());
-        *values
-            .select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a))
-            .1
-    };
-    // Each image's best pair fitness: the wanted-th best image sets the highest usable floor.
-    let mut best = vec![0.0f64; n];
-    for (e, cost) in graph.edges.iter().zip(pair_costs) {
-        for v in [e.i as usize, e.j as usize] {
-            best[v] = best[v].max(-cost);
-        }
-    }
-    let images = (criteria.min_image_fraction * n as f64).ceil() as usize;
-    let pairs = (criteria.min_pairs_per_image * n as f64 / 2.0).ceil() as usize;
-    let fitness = pair_costs.iter().map(|c| -c).collect();
-    floor.min(kth(best, images)).min(kth(fitness, pairs))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::flow::search::Criteria;
+    use crate::flow::search::FlowRule;
     use crate::scene::testing::{images, pair};
 
     /// The order decides what one unit of flow selects: on a triangle of equal costs the flow
@@ -483,52 +464,5 @@ mod tests {
         assert_eq!(skipped(vec![0, 1, 2]), [(1, 3)]);
         assert_eq!(skipped(vec![0, 2, 1]), [(1, 2)]);
         assert_eq!(skipped(vec![1, 0, 2]), [(2, 3)]);
-    }
-
-    #[test]
-    fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {
-        // A path 1-2-3-4-5: pair fitnesses 0.9, 0.8, 0.2, 0.1.
-        let images = images(5);
-        let pairs: Vec<VerifiedPair> = (1..5).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
-        let graph = ViewGraph::build(&images, &pairs, 15);
-        let costs = [-0.9, -0.8, -0.2, -0.1];
-        let options = |fraction: f64, per_image: f64, rule: Option<u64>| Options {
-            min_num_matches: 15,
-            rule: match rule {
-                Some(f) => FlowRule::Fixed(f),
-                None => FlowRule::Criteria(Criteria {
-                    min_image_fraction: fraction,
-                    min_pairs_per_image: per_image,
-                    min_pair_fraction: 0.0,
-                    min_pairs_each: 0.0,
-                }),
-            },
-            model: CostModel::disambiguation(),
-            unweighted_priors: false,
-            curve_factor: 0,
-            capture: Default::default(),
-            min_track_observations: 0,
-            min_track_length_ratio: 0.0,
-            spanning_forests: 0,
-            biconnected: false,
-        };
-        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor
-        // (0.6) already, and half of 0.4 pairs per image x 5 images is one pair.
-        let preset = CostModel::disambiguation().min_pair_fitness;
-        assert!(preset <= 0.8);
-        assert_eq!(
-            fitness_floor(&options(0.6, 0.4, None), &graph, &costs),
-            preset
-        );
-        // Four images need the floor at 0.2, all five at 0.1.
-        assert_eq!(fitness_floor(&options(0.8, 0.4, None), &graph, &costs), 0.2);
-        assert_eq!(fitness_floor(&options(1.0, 0.4, None), &graph, &costs), 0.1);
-        // Half of 1.2 pairs per image x 5 images is 3 pairs: the third best is 0.2.
-        assert_eq!(fitness_floor(&options(0.6, 1.2, None), &graph, &costs), 0.2);
-        // A fixed flow takes the floor as given.
-        assert_eq!(
-            fitness_floor(&options(1.0, 1.2, Some(3)), &graph, &costs),
-            preset
-        );
     }
 }

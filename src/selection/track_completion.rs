@@ -44,7 +44,7 @@ use std::collections::BinaryHeap;
 pub const MIN_TRACK_LENGTH: u32 = 3;
 
 /// What a completion asks for.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Needs {
     /// Maximum spanning forests by inliers to keep (0: none).
     pub spanning_forests: usize,
@@ -55,6 +55,13 @@ pub struct Needs {
 }
 
 impl Needs {
+    /// No completion.
+    pub const OFF: Needs = Needs {
+        spanning_forests: 0,
+        min_track_observations: 0,
+        min_track_length_ratio: 0.0,
+    };
+
     /// Whether any need is on.
     pub fn any(&self) -> bool {
         self.spanning_forests > 0

@@ -1,0 +1,374 @@
+//! The arc rules: which pair arcs of the paper's network are fixed (kept whatever the flow
+//! selects) or removed before the flow runs, besides the costs. Three sources, applied in this
+//! order: the user's overrides (`--keep_pairs`, `--forbid_pairs`, `--forbid_images`), close
+//! neighbours in a capture sequence (`--keep_neighbours`), and the fitness floor
+//! (`--min_pair_fitness`, lowered as far as the search needs).
+//!
+//! Rules change the network ([`crate::flow::network::SelectionProblem::restrict`]), never
+//! the costs, so the result stays an exact min-cost flow and is easy to explain:
+//! - a forbidden image leaves the network with all its pairs; the search criteria count only the
+//!   images that remain;
+//! - a forbidden pair's arc, or one below the floor, leaves the network;
+//! - a kept pair's arc leaves the network too, and the pair (with both its images) is added to
+//!   whatever the flow selects. The flow optimises the rest of the graph: the criteria and the
+//!   selection curve describe the flow's part, before the kept pairs are added.
+//!
+//! Files hold one entry per line (`name1 name2` for pairs, as `colmap matches_importer
+//! --match_type pairs` reads them; one image name per line for images); blank lines and lines
+//! starting with `#` are skipped.
+
+use crate::colmap::database::Image;
+use crate::flow::network::ArcRule;
+use crate::flow::search::FlowRule;
+use crate::scene::view_graph::ViewGraph;
+use crate::selection::capture_order::CaptureOrder;
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The arc rules a prune was asked for (part of [`crate::selection::parameters::Parameters`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ArcRules {
+    /// Pairs of images at most this many positions apart in the order are kept whatever the
+    /// flow selects (0: none).
+    pub keep_neighbours: u32,
+    /// `--keep_pairs`: the file of pairs always kept.
+    pub keep_pairs: Option<PathBuf>,
+    /// `--forbid_pairs`: the file of pairs never selected.
+    pub forbid_pairs: Option<PathBuf>,
+    /// `--forbid_images`: the file of images never selected.
+    pub forbid_images: Option<PathBuf>,
+}
+
+/// One list file as read: each entry with its 1-based line number.
+#[derive(Clone, Debug)]
+pub struct NameList {
+    /// The file read, for error messages and the run record.
+    pub path: PathBuf,
+    /// (line number, names): two names per pair-list entry, one per image-list entry.
+    pub entries: Vec<(usize, Vec<String>)>,
+}
+
+impl NameList {
+    /// Reads a pair list (`pairs = true`: two whitespace-separated names a line) or an image list
+    /// (the whole trimmed line is the name, so names may contain spaces).
+    pub fn read(path: &Path, pairs: bool) -> Result<NameList> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let mut entries = Vec::new();
+        for (k, line) in text.lines().enumerate() {
+            let line = line.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let names: Vec<String> = if pairs {
+                line.split_whitespace().map(str::to_string).collect()
+            } else {
+                vec![line.to_string()]
+            };
+            if names.len() != if pairs { 2 } else { 1 } {
+                bail!(
+                    "{} line {}: expected two image names `name1 name2`, found {}",
+                    path.display(),
+                    k + 1,
+                    names.len()
+                );
+            }
+            entries.push((k + 1, names));
+        }
+        Ok(NameList {
+            path: path.to_path_buf(),
+            entries,
+        })
+    }
+}
+
+/// The override files given on the command line (each optional).
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// `--keep_pairs`: pairs added to the selection whatever the flow does.
+    pub keep_pairs: Option<NameList>,
+    /// `--forbid_pairs`: pairs never selected.
+    pub forbid_pairs: Option<NameList>,
+    /// `--forbid_images`: images taken out of the network with all their pairs.
+    pub forbid_images: Option<NameList>,
+}
+
+/// The overrides as listed in the report, by image name.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Listed {
+    /// Kept pairs, names as given in the file.
+    pub keep_pairs: Vec<[String; 2]>,
+    /// Forbidden pairs, names as given in the file (view-graph edges or not).
+    pub forbid_pairs: Vec<[String; 2]>,
+    /// Forbidden pairs that are no view-graph edge: never selected anyway.
+    pub forbid_pairs_not_in_view_graph: usize,
+    /// Forbidden image names, as given (isolated images included).
+    pub forbid_images: Vec<String>,
+    /// Pairs taken out of the network because one of their images is forbidden.
+    pub pairs_of_forbidden_images: usize,
+}
+
+/// Overrides resolved against a view graph.
+#[derive(Clone, Debug)]
+pub struct Resolved {
+    /// Indexed like `ViewGraph::edges`.
+    pub edges: Vec<ArcRule>,
+    /// Indexed like `ViewGraph::image_ids`.
+    pub forbidden_vertices: Vec<bool>,
+    /// What was resolved, by name, for the report.
+    pub listed: Listed,
+}
+
+impl Overrides {
+    /// Checks every name against `images` and every kept pair against `graph`. Errors name the
+    /// file and line: an unknown image, a kept pair that is no view-graph edge (fewer than
+    /// `min_num_matches` inliers, or never verified), a kept pair also forbidden.
+    pub fn resolve(
+        &self,
+        images: &[Image],
+        graph: &ViewGraph,
+        min_num_matches: usize,
+    ) -> Result<Resolved> {
+        let names = Names::new(images, graph);
+        let mut resolved = Resolved {
+            edges: vec![ArcRule::Free; graph.edges.len()],
+            forbidden_vertices: vec![false; graph.num_vertices()],
+            listed: Listed::default(),
+        };
+        if let Some(list) = &self.forbid_images {
+            resolved.forbid_images(list, &names, graph)?;
+        }
+        if let Some(list) = &self.forbid_pairs {
+            resolved.forbid_pairs(list, &names)?;
+        }
+        if let Some(list) = &self.keep_pairs {
+            resolved.keep_pairs(list, &names, min_num_matches)?;
+        }
+        Ok(resolved)
+    }
+}
+
+/// Image names and pairs of names looked up in the view graph, for the override files.
+struct Names<'a> {
+    ids: HashMap<&'a str, u32>,
+    graph: &'a ViewGraph,
+    edge_index: HashMap<(usize, usize), usize>,
+}
+
+impl<'a> Names<'a> {
+    fn new(images: &'a [Image], graph: &'a ViewGraph) -> Names<'a> {
+        Names {
+            ids: images
+                .iter()
+                .map(|im| (im.name.as_str(), im.image_id))
+                .collect(),
+            graph,
+            edge_index: graph
+                .edges
+                .iter()
+                .enumerate()
+                .map(|(k, e)| ((e.i as usize, e.j as usize), k))
+                .collect(),
+        }
+    }
+
+    /// The view-graph vertex of an image_id, if it has one.
+    fn vertex(&self, id: u32) -> Option<usize> {
+        self.graph.image_ids.binary_search(&id).ok()
+    }
+
+    /// The image_id of the image named on `line` of `list`.
+    fn image(&self, list: &NameList, line: usize, name: &str) -> Result<u32> {
+        self.ids.get(name).copied().with_context(|| {
+            format!(
+                "{} line {line}: no image named `{name}` in the database",
+                list.path.display()
+            )
+        })
+    }
+
+    /// The edge of a pair entry, or None when it is no view-graph edge.
+    fn edge(&self, list: &NameList, line: usize, names: &[String]) -> Result<Option<usize>> {
+        let a = self.image(list, line, &names[0])?;
+        let b = self.image(list, line, &names[1])?;
+        if a == b {
+            bail!(
+                "{} line {line}: `{}` is paired with itself",
+                list.path.display(),
+                names[0]
+            );
+        }
+        Ok(match (self.vertex(a), self.vertex(b)) {
+            (Some(x), Some(y)) => self.edge_index.get(&(x.min(y), x.max(y))).copied(),
+            _ => None,
+        })
+    }
+}
+
+impl Resolved {
+    /// `--forbid_images`: the images and every pair of theirs leave the network.
+    fn forbid_images(&mut self, list: &NameList, names: &Names, graph: &ViewGraph) -> Result<()> {
+        for (line, entry) in &list.entries {
+            if let Some(v) = names.vertex(names.image(list, *line, &entry[0])?) {
+                self.forbidden_vertices[v] = true;
+            }
+            self.listed.forbid_images.push(entry[0].clone());
+        }
+        for (k, e) in graph.edges.iter().enumerate() {
+            if self.forbidden_vertices[e.i as usize] || self.forbidden_vertices[e.j as usize] {
+                self.edges[k] = ArcRule::Removed;
+                self.listed.pairs_of_forbidden_images += 1;
+            }
+        }
+        Ok(())
+    }
+
+    /// `--forbid_pairs`: the pairs' arcs leave the network.
+    fn forbid_pairs(&mut self, list: &NameList, names: &Names) -> Result<()> {
+        for (line, entry) in &list.entries {
+            match names.edge(list, *line, entry)? {
+                Some(k) => self.edges[k] = ArcRule::Removed,
+                None => self.listed.forbid_pairs_not_in_view_graph += 1,
+            }
+            self.listed
+                .forbid_pairs
+                .push([entry[0].clone(), entry[1].clone()]);
+        }
+        Ok(())
+    }
+
+    /// `--keep_pairs`: the pairs are fixed; each must be an edge and not forbidden.
+    fn keep_pairs(&mut self, list: &NameList, names: &Names, min_num_matches: usize) -> Result<()> {
+        for (line, entry) in &list.entries {
+            let where_ = format!("{} line {line}", list.path.display());
+            let Some(k) = names.edge(list, *line, entry)? else {
+                bail!(
+                    "{where_}: `{}` `{}` is not a verified pair with at least {min_num_matches} inliers, so it cannot be kept",
+                    entry[0], entry[1]
+                );
+            };
+            if self.edges[k] == ArcRule::Removed {
+                bail!(
+                    "{where_}: `{}` `{}` is kept but also forbidden (as a pair or by one of its images)",
+                    entry[0], entry[1]
+                );
+            }
+            self.edges[k] = ArcRule::Fixed;
+            self.listed
+                .keep_pairs
+                .push([entry[0].clone(), entry[1].clone()]);
+        }
+        Ok(())
+    }
+}
+
+/// Fixes every free edge whose images are at most `window` positions apart in `order`, so the
+/// pair is kept whatever the flow selects; forbidden pairs stay forbidden. Returns how many.
+/// Why: in a capture known to be a sequence, close neighbours see the same things, so their
+/// verified pairs are true, and keeping them all gives a walk between look-alike objects the
+/// redundancy a mapper needs to cross it in one piece (docs/cli.md).
+pub fn keep_neighbours(
+    rules: &mut [ArcRule],
+    graph: &ViewGraph,
+    order: &CaptureOrder,
+    window: u32,
+) -> usize {
+    if window == 0 {
+        return 0;
+    }
+    let mut kept = 0;
+    for (rule, e) in rules.iter_mut().zip(&graph.edges) {
+        if *rule == ArcRule::Free && order.within(e.i, e.j, window) {
+            *rule = ArcRule::Fixed;
+            kept += 1;
+        }
+    }
+    kept
+}
+
+/// Removes every free edge whose fitness (−cost) is below `floor`. Returns how many.
+pub fn remove_below_floor(rules: &mut [ArcRule], pair_costs: &[f64], floor: f64) -> usize {
+    let mut removed = 0;
+    for (rule, cost) in rules.iter_mut().zip(pair_costs) {
+        if *rule == ArcRule::Free && -cost < floor {
+            *rule = ArcRule::Removed;
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// The cost model's `min_pair_fitness` (`floor`), lowered where needed so that the image
+/// criterion's share of images keep a pair above it, and at least half as many pairs as the
+/// pair criterion asks for reach it. On scenes where the priors score every pair low (real
+/// photos where few triangles close within the loop tolerance) a fixed floor left the flow too
+/// few pairs for `colmap mapper` to start a model (docs/priors.md). With a fixed flow it is
+/// applied as given.
+pub fn fitness_floor(floor: f64, rule: &FlowRule, graph: &ViewGraph, pair_costs: &[f64]) -> f64 {
+    let FlowRule::Criteria(criteria) = rule else {
+        return floor;
+    };
+    let n = graph.num_vertices();
+    if floor <= 0.0 || n == 0 {
+        return floor;
+    }
+    // The k-th largest of some values (k >= 1, at most their count).
+    let kth = |mut values: Vec<f64>, k: usize| {
+        let k = k.clamp(1, values.len());
+        *values
+            .select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a))
+            .1
+    };
+    // Each image's best pair fitness: the wanted-th best image sets the highest usable floor.
+    let mut best = vec![0.0f64; n];
+    for (e, cost) in graph.edges.iter().zip(pair_costs) {
+        for v in [e.i as usize, e.j as usize] {
+            best[v] = best[v].max(-cost);
+        }
+    }
+    let images = (criteria.min_image_fraction * n as f64).ceil() as usize;
+    let pairs = (criteria.min_pairs_per_image * n as f64 / 2.0).ceil() as usize;
+    let fitness = pair_costs.iter().map(|c| -c).collect();
+    floor.min(kth(best, images)).min(kth(fitness, pairs))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::colmap::database::VerifiedPair;
+    use crate::flow::search::Criteria;
+    use crate::scene::testing::{images, pair};
+
+    #[test]
+    fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {
+        // A path 1-2-3-4-5: pair fitnesses 0.9, 0.8, 0.2, 0.1.
+        let images = images(5);
+        let pairs: Vec<VerifiedPair> = (1..5).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let costs = [-0.9, -0.8, -0.2, -0.1];
+        let rule = |fraction: f64, per_image: f64, fixed: Option<u64>| match fixed {
+            Some(f) => FlowRule::Fixed(f),
+            None => FlowRule::Criteria(Criteria {
+                min_image_fraction: fraction,
+                min_pairs_per_image: per_image,
+                min_pair_fraction: 0.0,
+                min_pairs_each: 0.0,
+            }),
+        };
+        // The disambiguation preset's floor.
+        let preset = 0.6;
+        let floor = |rule: FlowRule| fitness_floor(preset, &rule, &graph, &costs);
+        // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor
+        // (0.6) already, and half of 0.4 pairs per image x 5 images is one pair.
+        assert_eq!(floor(rule(0.6, 0.4, None)), preset);
+        // Four images need the floor at 0.2, all five at 0.1.
+        assert_eq!(floor(rule(0.8, 0.4, None)), 0.2);
+        assert_eq!(floor(rule(1.0, 0.4, None)), 0.1);
+        // Half of 1.2 pairs per image x 5 images is 3 pairs: the third best is 0.2.
+        assert_eq!(floor(rule(0.6, 1.2, None)), 0.2);
+        // A fixed flow takes the floor as given.
+        assert_eq!(floor(rule(1.0, 1.2, Some(3))), preset);
+    }
+}
