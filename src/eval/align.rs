@@ -49,6 +49,11 @@ pub struct Pose {
     pub centre: Vector3<f64>,
 }
 
+/// Position error limit of a correct camera, as a fraction of the ground truth's extent.
+pub const POSITION_TOLERANCE: f64 = 0.05;
+/// Rotation error limit of a correct camera, in degrees.
+pub const ROTATION_TOLERANCE_DEG: f64 = 5.0;
+
 /// Cameras whose aligned centre is within `position` (truth units) and whose aligned rotation is
 /// within `rotation_deg` of the truth; the same limits that decide a correct camera.
 #[derive(Clone, Copy, Debug)]
@@ -274,8 +279,8 @@ pub fn evaluate(estimated: &[ModelImage], truth: &[ModelImage]) -> Result<Evalua
     let dst: Vec<_> = pairs.iter().map(|(_, t)| pose(t)).collect();
     let extent = scene_extent(&truth.iter().map(|t| t.centre()).collect::<Vec<_>>());
     let tolerance = Tolerance {
-        position: crate::eval::score::POSITION_TOLERANCE * extent,
-        rotation_deg: crate::eval::score::ROTATION_TOLERANCE_DEG,
+        position: POSITION_TOLERANCE * extent,
+        rotation_deg: ROTATION_TOLERANCE_DEG,
     };
     let (similarity, _) = align_poses(&src, &dst, tolerance, 5000, 0)?;
     let errors = pairs
