@@ -22,17 +22,11 @@ pub mod track_fraction;
 pub mod tracks;
 pub mod triangulation_angle;
 pub mod unique_tracks;
+pub mod values;
+
+pub use values::PriorValues;
 
 use crate::scene::Scene;
-
-/// Raw values of one prior: one per vertex (image prior) or per edge (pair prior).
-#[derive(Clone, Debug, PartialEq)]
-pub struct PriorValues {
-    /// The prior's name, which [`crate::costs::PriorModel::name`] matches it by.
-    pub name: &'static str,
-    /// One raw value per vertex or edge, in graph order; NaN where the prior does not apply.
-    pub values: Vec<f64>,
-}
 
 /// The image priors of the `general` preset.
 pub fn general_image_priors(scene: &Scene) -> Vec<PriorValues> {

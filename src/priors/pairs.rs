@@ -2,7 +2,7 @@
 //! cameras, focal-length estimation and a relative pose per pair; multiple motions also need the
 //! raw matches. [`needs`] tells the pipeline which of those to load into the [`Scene`].
 
-use super::{backbone_tracks, triangulation_angle, unique_tracks, PriorValues};
+use super::{backbone_tracks, triangulation_angle, unique_tracks, values::PriorValues};
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
 use crate::geometry::camera::CameraModel;
 use crate::geometry::focal::{self, FundamentalPair};
