@@ -4,7 +4,8 @@
 use crate::colmap::ids::{self, TwoViewConfig};
 use crate::eval::synth::observe::ImageObservations;
 use crate::eval::synth::scene::ScenePoint;
-use crate::eval::synth::{GtImage, GtPair, SceneSpec};
+use crate::eval::synth::spec::SceneSpec;
+use crate::eval::synth::truth::{GtImage, GtPair};
 use anyhow::Result;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rand::seq::SliceRandom;

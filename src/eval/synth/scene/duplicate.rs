@@ -6,7 +6,8 @@
 //! copies into one ghosted model. The overview cameras truly link the groups.
 
 use crate::eval::synth::scene::{default_surfaces, look_at, sample_surface, ScenePoint, Surface};
-use crate::eval::synth::{GtImage, SceneSpec};
+use crate::eval::synth::spec::SceneSpec;
+use crate::eval::synth::truth::GtImage;
 use nalgebra::{Rotation3, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
