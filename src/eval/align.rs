@@ -112,22 +112,8 @@ pub fn align_poses(
         let count = mask.iter().filter(|&&m| m).count();
         (mask, count, cost)
     };
-    let total = n * (n - 1) / 2;
-    let hypotheses: Vec<(usize, usize)> = if total <= max_hypotheses {
-        (0..n)
-            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-            .collect()
-    } else {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        (0..max_hypotheses)
-            .map(|_| {
-                let idx = sample(&mut rng, n, 2);
-                (idx.index(0), idx.index(1))
-            })
-            .collect()
-    };
     let mut best: Option<(Similarity, Vec<bool>, usize, f64)> = None;
-    for (i, j) in hypotheses {
+    for (i, j) in hypotheses(n, max_hypotheses, seed) {
         let Some(sim) = fit_given_rotation(
             implied[i],
             &[estimated[i], estimated[j]],
@@ -160,6 +146,25 @@ pub fn align_poses(
         (sim, mask, count, cost) = (refit, refit_mask, refit_count, refit_cost);
     }
     Ok((sim, mask))
+}
+
+/// The pairs of cameras (i < j of `n`) [`align_poses`] tries: all of them, or `max_hypotheses`
+/// drawn by a generator seeded with `seed` when there are more.
+fn hypotheses(n: usize, max_hypotheses: usize, seed: u64) -> Vec<(usize, usize)> {
+    let total = n * (n - 1) / 2;
+    if total <= max_hypotheses {
+        (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .collect()
+    } else {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..max_hypotheses)
+            .map(|_| {
+                let idx = sample(&mut rng, n, 2);
+                (idx.index(0), idx.index(1))
+            })
+            .collect()
+    }
 }
 
 /// Scale and translation by least squares once the rotation is fixed; None when the estimated
