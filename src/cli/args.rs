@@ -38,7 +38,7 @@ pub struct FlowArgs {
     /// Use this total flow F instead of searching for it. More flow is not always more pairs:
     /// past some F the selection shrinks (each further unit runs through one image alone), and a
     /// flow that keeps no pair is refused.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each", "min_track_observations", "min_track_length_ratio", "spanning_forests", "biconnected"])]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), conflicts_with_all = ["min_image_fraction", "min_pairs_per_image", "min_pair_fraction", "min_pairs_each"])]
     pub flow: Option<u64>,
     /// Search: smallest F selecting at least this fraction of the view graph's images.
     #[arg(long, value_parser = fraction)]

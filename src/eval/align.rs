@@ -49,6 +49,11 @@ pub struct Pose {
     pub centre: Vector3<f64>,
 }
 
+/// Position error limit of a correct camera, as a fraction of the ground truth's extent.
+pub const POSITION_TOLERANCE: f64 = 0.05;
+/// Rotation error limit of a correct camera, in degrees.
+pub const ROTATION_TOLERANCE_DEG: f64 = 5.0;
+
 /// Cameras whose aligned centre is within `position` (truth units) and whose aligned rotation is
 /// within `rotation_deg` of the truth; the same limits that decide a correct camera.
 #[derive(Clone, Copy, Debug)]
@@ -107,22 +112,8 @@ pub fn align_poses(
         let count = mask.iter().filter(|&&m| m).count();
         (mask, count, cost)
     };
-    let total = n * (n - 1) / 2;
-    let hypotheses: Vec<(usize, usize)> = if total <= max_hypotheses {
-        (0..n)
-            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-            .collect()
-    } else {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        (0..max_hypotheses)
-            .map(|_| {
-                let idx = sample(&mut rng, n, 2);
-                (idx.index(0), idx.index(1))
-            })
-            .collect()
-    };
     let mut best: Option<(Similarity, Vec<bool>, usize, f64)> = None;
-    for (i, j) in hypotheses {
+    for (i, j) in hypotheses(n, max_hypotheses, seed) {
         let Some(sim) = fit_given_rotation(
             implied[i],
             &[estimated[i], estimated[j]],
@@ -155,6 +146,25 @@ pub fn align_poses(
         (sim, mask, count, cost) = (refit, refit_mask, refit_count, refit_cost);
     }
     Ok((sim, mask))
+}
+
+/// The pairs of cameras (i < j of `n`) [`align_poses`] tries: all of them, or `max_hypotheses`
+/// drawn by a generator seeded with `seed` when there are more.
+fn hypotheses(n: usize, max_hypotheses: usize, seed: u64) -> Vec<(usize, usize)> {
+    let total = n * (n - 1) / 2;
+    if total <= max_hypotheses {
+        (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .collect()
+    } else {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..max_hypotheses)
+            .map(|_| {
+                let idx = sample(&mut rng, n, 2);
+                (idx.index(0), idx.index(1))
+            })
+            .collect()
+    }
 }
 
 /// Scale and translation by least squares once the rotation is fixed; None when the estimated
@@ -274,8 +284,8 @@ pub fn evaluate(estimated: &[ModelImage], truth: &[ModelImage]) -> Result<Evalua
     let dst: Vec<_> = pairs.iter().map(|(_, t)| pose(t)).collect();
     let extent = scene_extent(&truth.iter().map(|t| t.centre()).collect::<Vec<_>>());
     let tolerance = Tolerance {
-        position: crate::eval::score::POSITION_TOLERANCE * extent,
-        rotation_deg: crate::eval::score::ROTATION_TOLERANCE_DEG,
+        position: POSITION_TOLERANCE * extent,
+        rotation_deg: ROTATION_TOLERANCE_DEG,
     };
     let (similarity, _) = align_poses(&src, &dst, tolerance, 5000, 0)?;
     let errors = pairs

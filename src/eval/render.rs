@@ -174,147 +174,226 @@ impl Cuboid {
     }
 }
 
+/// A camera's centre and the point it looks at.
+type CameraAim = (Vector3<f64>, Vector3<f64>);
+
+/// The random draws a scene is built from, each from its own generator so that the textures do
+/// not depend on the cameras: the object's textures, then one per further box; the cameras'
+/// jitter.
+struct Draws {
+    /// Texture seeds, seeded with the scene's seed.
+    textures: ChaCha8Rng,
+    /// Camera jitter, seeded with the scene's seed ^ 0xC0FFEE.
+    cameras: ChaCha8Rng,
+    /// Texture seeds of the object's block.
+    object_tex: [u64; 6],
+    /// Texture seeds of the box on top of the block.
+    top_tex: [u64; 6],
+}
+
+impl Draws {
+    fn new(seed: u64) -> Draws {
+        let mut textures = ChaCha8Rng::seed_from_u64(seed);
+        let mut tex = || -> [u64; 6] { std::array::from_fn(|_| textures.gen()) };
+        let (object_tex, top_tex) = (tex(), tex());
+        Draws {
+            textures,
+            cameras: ChaCha8Rng::seed_from_u64(seed ^ 0xC0FFEE),
+            object_tex,
+            top_tex,
+        }
+    }
+
+    /// The next box's texture seeds.
+    fn tex(&mut self) -> [u64; 6] {
+        std::array::from_fn(|_| self.textures.gen())
+    }
+
+    /// A random horizontal offset of up to `s / 2` along x and y.
+    fn jitter(&mut self, s: f64) -> Vector3<f64> {
+        let rng = &mut self.cameras;
+        Vector3::new(rng.gen::<f64>() - 0.5, rng.gen::<f64>() - 0.5, 0.0) * s
+    }
+
+    /// The object: a table-high block with a smaller box on it, offset so no view is symmetric.
+    fn object(&self, x: f64, y: f64) -> Vec<Cuboid> {
+        vec![
+            Cuboid::new(
+                [x - 0.6, y - 0.4, 0.0],
+                [x + 0.6, y + 0.4, 0.8],
+                self.object_tex,
+            ),
+            Cuboid::new(
+                [x - 0.5, y - 0.3, 0.8],
+                [x + 0.1, y + 0.2, 1.3],
+                self.top_tex,
+            ),
+        ]
+    }
+
+    /// `n` cameras around the object at (x, 0), on angles [from, from + span) (radians).
+    fn orbit(&mut self, poses: &mut Vec<CameraAim>, x: f64, n: usize, from: f64, span: f64) {
+        for k in 0..n {
+            let a = from + span * k as f64 / n as f64;
+            let centre = Vector3::new(x + 2.8 * a.cos(), 2.8 * a.sin(), 1.6) + self.jitter(0.2);
+            poses.push((centre, Vector3::new(x, 0.0, 0.7) + self.jitter(0.2)));
+        }
+    }
+}
+
+/// [`SceneKind::Room`]: its boxes and `num_images` cameras.
+fn room(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let (mut cuboids, mut poses) = (Vec::new(), Vec::new());
+    let mut room = Cuboid::new([-5.0, -5.0, 0.0], [5.0, 5.0, 3.5], draws.tex());
+    room.inside = true;
+    cuboids.push(room);
+    cuboids.extend(draws.object(0.0, 0.0));
+    cuboids.push(Cuboid::new([2.0, 3.0, 0.0], [3.5, 4.0, 1.0], draws.tex()));
+    cuboids.push(Cuboid::new(
+        [-4.0, -3.5, 0.0],
+        [-3.0, -2.0, 1.5],
+        draws.tex(),
+    ));
+    draws.orbit(&mut poses, 0.0, num_images, 0.0, TAU);
+    (cuboids, poses)
+}
+
+/// [`SceneKind::Twin`]: its boxes and `num_images` cameras.
+fn twin(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let (mut cuboids, mut poses) = (Vec::new(), Vec::new());
+    let mut ground = Cuboid::new([-16.0, -10.0, -1.0], [16.0, 10.0, 0.0], draws.tex());
+    ground.east = draws.tex();
+    cuboids.push(ground);
+    cuboids.extend(draws.object(-7.0, 0.0));
+    cuboids.extend(draws.object(7.0, 0.0));
+    // Three boxes of their own between the objects: what a walk from one object to
+    // the other passes (the ground's texture alone barely matches: its discs look
+    // alike to SIFT's ratio test).
+    for x in [-3.2, 0.0, 3.2] {
+        cuboids.push(Cuboid::new(
+            [x - 0.5, 0.5, 0.0],
+            [x + 0.5, 1.5, 1.6],
+            draws.tex(),
+        ));
+    }
+    let links = (num_images / 7).max(2);
+    let per_orbit = (num_images - links) / 2;
+    draws.orbit(&mut poses, -7.0, per_orbit, 0.0, TAU);
+    draws.orbit(&mut poses, 7.0, num_images - links - per_orbit, PI, TAU);
+    // The walk, beside the orbits, looking across at the boxes: the first view sees
+    // the first object, the last the second, each the boxes its neighbours see.
+    // (Overview views from far back, as this scene had first, matched each other
+    // only: SIFT did not bridge the 6x scale.)
+    let walk: Vec<_> = (0..links)
+        .map(|k| {
+            let x = -4.2 + 8.4 * k as f64 / (links - 1) as f64;
+            let centre = Vector3::new(x, -5.0, 1.6) + draws.jitter(0.2);
+            (centre, Vector3::new(1.3 * x, 1.0, 0.6) + draws.jitter(0.2))
+        })
+        .collect();
+    // In capture order: round the first object, the walk to the second, round it
+    // from the side the walk ends on.
+    poses.splice(per_orbit..per_orbit, walk);
+    (cuboids, poses)
+}
+
+/// [`SceneKind::Symmetric`]: its boxes and `num_images` cameras.
+fn symmetric(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let (mut cuboids, mut poses) = (Vec::new(), Vec::new());
+    // Faces -x/+x and -y/+y share their seeds; the top box is centred.
+    let [a, _, c, _, e, f] = draws.object_tex;
+    let [ta, _, tc, _, te, tf] = draws.top_tex;
+    for (min, max, faces) in [
+        ([-0.6, -0.4, 0.0], [0.6, 0.4, 0.8], [a, a, c, c, e, f]),
+        (
+            [-0.3, -0.25, 0.8],
+            [0.3, 0.25, 1.3],
+            [ta, ta, tc, tc, te, tf],
+        ),
+    ] {
+        let mut part = Cuboid::new(min, max, faces);
+        part.half_turn = true;
+        cuboids.push(part);
+    }
+    draws.orbit(&mut poses, 0.0, num_images, 0.0, TAU);
+    (cuboids, poses)
+}
+
+/// [`SceneKind::Duplicate`]: its boxes and `num_images` cameras.
+fn duplicate(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let (mut cuboids, mut poses) = (Vec::new(), Vec::new());
+    // A long room whose halves (x < 0, x > 0) have their own wall textures; the same
+    // object stands in the middle of each half.
+    let mut room = Cuboid::new([-10.0, -4.0, 0.0], [10.0, 4.0, 3.5], draws.tex());
+    room.east = draws.tex();
+    room.inside = true;
+    cuboids.push(room);
+    cuboids.extend(draws.object(-5.0, 0.0));
+    cuboids.extend(draws.object(5.0, 0.0));
+    let walk = (num_images / 4).max(2);
+    let per_orbit = (num_images - walk) / 2;
+    // Half orbits on the walk's side, so the walk sees what the orbits see.
+    draws.orbit(&mut poses, -5.0, per_orbit, 1.1 * PI, 0.8 * PI);
+    draws.orbit(
+        &mut poses,
+        5.0,
+        num_images - walk - per_orbit,
+        1.1 * PI,
+        0.8 * PI,
+    );
+    for k in 0..walk {
+        let x = -6.0 + 12.0 * k as f64 / (walk - 1) as f64;
+        let centre = Vector3::new(x, -3.5, 1.6) + draws.jitter(0.2);
+        poses.push((centre, Vector3::new(x, 4.0, 1.2) + draws.jitter(0.4)));
+    }
+    (cuboids, poses)
+}
+
+/// The ground truth of cameras at `poses` (in order, named `0000.png`, ...), all the one
+/// rendering camera.
+fn ground_truth(poses: &[CameraAim]) -> GroundTruth {
+    let images = poses
+        .iter()
+        .enumerate()
+        .map(|(k, (centre, target))| {
+            let rotation = look_at(centre, target);
+            GtImage {
+                image_id: k as u32 + 1,
+                name: format!("{k:04}.png"),
+                translation: -(rotation * centre),
+                rotation,
+                centre: *centre,
+            }
+        })
+        .collect();
+    let camera = GtCamera {
+        camera_id: 1,
+        model_id: SIMPLE_RADIAL,
+        width: WIDTH,
+        height: HEIGHT,
+        params: vec![FOCAL, WIDTH as f64 / 2.0, HEIGHT as f64 / 2.0, 0.0],
+    };
+    GroundTruth {
+        camera,
+        images,
+        pairs: Vec::new(),
+    }
+}
+
 impl Scene {
     /// Builds `kind` with `num_images` cameras; `seed` jitters the cameras and picks textures.
     pub fn build(kind: SceneKind, num_images: usize, seed: u64) -> Result<Scene> {
         ensure!(num_images >= 4, "a rendered scene needs at least 4 images");
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut tex = || -> [u64; 6] { std::array::from_fn(|_| rng.gen()) };
-        let (object_tex, top_tex) = (tex(), tex());
-        // The object: a table-high block with a smaller box on it, offset so no view is symmetric.
-        let object = |x: f64, y: f64| {
-            vec![
-                Cuboid::new([x - 0.6, y - 0.4, 0.0], [x + 0.6, y + 0.4, 0.8], object_tex),
-                Cuboid::new([x - 0.5, y - 0.3, 0.8], [x + 0.1, y + 0.2, 1.3], top_tex),
-            ]
-        };
-        let mut cuboids = Vec::new();
-        let mut poses = Vec::new();
-        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xC0FFEE);
-        let mut jitter =
-            |s: f64| Vector3::new(rng.gen::<f64>() - 0.5, rng.gen::<f64>() - 0.5, 0.0) * s;
-        // n cameras around the object at (x, 0), on angles [from, from + span) (radians).
-        let mut orbit = |poses: &mut Vec<_>, x: f64, n: usize, from: f64, span: f64| {
-            for k in 0..n {
-                let a = from + span * k as f64 / n as f64;
-                let centre = Vector3::new(x + 2.8 * a.cos(), 2.8 * a.sin(), 1.6) + jitter(0.2);
-                poses.push((centre, Vector3::new(x, 0.0, 0.7) + jitter(0.2)));
-            }
-        };
-        match kind {
-            SceneKind::Room => {
-                let mut room = Cuboid::new([-5.0, -5.0, 0.0], [5.0, 5.0, 3.5], tex());
-                room.inside = true;
-                cuboids.push(room);
-                cuboids.extend(object(0.0, 0.0));
-                cuboids.push(Cuboid::new([2.0, 3.0, 0.0], [3.5, 4.0, 1.0], tex()));
-                cuboids.push(Cuboid::new([-4.0, -3.5, 0.0], [-3.0, -2.0, 1.5], tex()));
-                orbit(&mut poses, 0.0, num_images, 0.0, TAU);
-            }
-            SceneKind::Twin => {
-                let mut ground = Cuboid::new([-16.0, -10.0, -1.0], [16.0, 10.0, 0.0], tex());
-                ground.east = tex();
-                cuboids.push(ground);
-                cuboids.extend(object(-7.0, 0.0));
-                cuboids.extend(object(7.0, 0.0));
-                // Three boxes of their own between the objects: what a walk from one object to
-                // the other passes (the ground's texture alone barely matches: its discs look
-                // alike to SIFT's ratio test).
-                for x in [-3.2, 0.0, 3.2] {
-                    cuboids.push(Cuboid::new([x - 0.5, 0.5, 0.0], [x + 0.5, 1.5, 1.6], tex()));
-                }
-                let links = (num_images / 7).max(2);
-                let per_orbit = (num_images - links) / 2;
-                orbit(&mut poses, -7.0, per_orbit, 0.0, TAU);
-                orbit(&mut poses, 7.0, num_images - links - per_orbit, PI, TAU);
-                // The walk, beside the orbits, looking across at the boxes: the first view sees
-                // the first object, the last the second, each the boxes its neighbours see.
-                // (Overview views from far back, as this scene had first, matched each other
-                // only: SIFT did not bridge the 6x scale.)
-                let walk: Vec<_> = (0..links)
-                    .map(|k| {
-                        let x = -4.2 + 8.4 * k as f64 / (links - 1) as f64;
-                        let centre = Vector3::new(x, -5.0, 1.6) + jitter(0.2);
-                        (centre, Vector3::new(1.3 * x, 1.0, 0.6) + jitter(0.2))
-                    })
-                    .collect();
-                // In capture order: round the first object, the walk to the second, round it
-                // from the side the walk ends on.
-                poses.splice(per_orbit..per_orbit, walk);
-            }
-            SceneKind::Symmetric => {
-                // Faces -x/+x and -y/+y share their seeds; the top box is centred.
-                let [a, _, c, _, e, f] = object_tex;
-                let [ta, _, tc, _, te, tf] = top_tex;
-                for (min, max, faces) in [
-                    ([-0.6, -0.4, 0.0], [0.6, 0.4, 0.8], [a, a, c, c, e, f]),
-                    (
-                        [-0.3, -0.25, 0.8],
-                        [0.3, 0.25, 1.3],
-                        [ta, ta, tc, tc, te, tf],
-                    ),
-                ] {
-                    let mut part = Cuboid::new(min, max, faces);
-                    part.half_turn = true;
-                    cuboids.push(part);
-                }
-                orbit(&mut poses, 0.0, num_images, 0.0, TAU);
-            }
-            SceneKind::Duplicate => {
-                // A long room whose halves (x < 0, x > 0) have their own wall textures; the same
-                // object stands in the middle of each half.
-                let mut room = Cuboid::new([-10.0, -4.0, 0.0], [10.0, 4.0, 3.5], tex());
-                room.east = tex();
-                room.inside = true;
-                cuboids.push(room);
-                cuboids.extend(object(-5.0, 0.0));
-                cuboids.extend(object(5.0, 0.0));
-                let walk = (num_images / 4).max(2);
-                let per_orbit = (num_images - walk) / 2;
-                // Half orbits on the walk's side, so the walk sees what the orbits see.
-                orbit(&mut poses, -5.0, per_orbit, 1.1 * PI, 0.8 * PI);
-                orbit(
-                    &mut poses,
-                    5.0,
-                    num_images - walk - per_orbit,
-                    1.1 * PI,
-                    0.8 * PI,
-                );
-                for k in 0..walk {
-                    let x = -6.0 + 12.0 * k as f64 / (walk - 1) as f64;
-                    let centre = Vector3::new(x, -3.5, 1.6) + jitter(0.2);
-                    poses.push((centre, Vector3::new(x, 4.0, 1.2) + jitter(0.4)));
-                }
-            }
-        }
-        let images = poses
-            .iter()
-            .enumerate()
-            .map(|(k, (centre, target))| {
-                let rotation = look_at(centre, target);
-                GtImage {
-                    image_id: k as u32 + 1,
-                    name: format!("{k:04}.png"),
-                    translation: -(rotation * centre),
-                    rotation,
-                    centre: *centre,
-                }
-            })
-            .collect();
-        let camera = GtCamera {
-            camera_id: 1,
-            model_id: SIMPLE_RADIAL,
-            width: WIDTH,
-            height: HEIGHT,
-            params: vec![FOCAL, WIDTH as f64 / 2.0, HEIGHT as f64 / 2.0, 0.0],
+        let mut draws = Draws::new(seed);
+        let (cuboids, poses) = match kind {
+            SceneKind::Room => room(&mut draws, num_images),
+            SceneKind::Twin => twin(&mut draws, num_images),
+            SceneKind::Symmetric => symmetric(&mut draws, num_images),
+            SceneKind::Duplicate => duplicate(&mut draws, num_images),
         };
         Ok(Scene {
             cuboids,
-            truth: GroundTruth {
-                camera,
-                images,
-                pairs: Vec::new(),
-            },
+            truth: ground_truth(&poses),
         })
     }
 

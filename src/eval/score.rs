@@ -5,16 +5,11 @@
 //! registered onto the other) registers images that are not correct.
 
 use crate::colmap::model;
-use crate::eval::align;
+use crate::eval::align::{self, POSITION_TOLERANCE, ROTATION_TOLERANCE_DEG};
 use anyhow::{ensure, Result};
 use serde::Serialize;
 use std::collections::HashMap;
 use std::path::Path;
-
-/// Position error limit, as a fraction of the ground truth's extent.
-pub const POSITION_TOLERANCE: f64 = 0.05;
-/// Rotation error limit in degrees.
-pub const ROTATION_TOLERANCE_DEG: f64 = 5.0;
 
 /// One ground-truth image scored against a reconstruction.
 #[derive(Clone, Debug, Serialize)]

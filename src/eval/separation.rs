@@ -168,53 +168,81 @@ impl Separation {
     }
 }
 
+/// A CSV's header and rows (blank lines skipped), checking every row has the header's fields;
+/// `what` names the CSV in errors.
+fn csv_rows(text: &str, what: &str) -> Result<(Vec<String>, Vec<Vec<String>>)> {
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<String> = lines
+        .next()
+        .with_context(|| format!("{what} is empty"))?
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let body = lines
+        .map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>())
+        .collect::<Vec<_>>();
+    if let Some(bad) = body.iter().position(|r| r.len() != header.len()) {
+        bail!(
+            "{what} line {}: {} fields, the header has {}",
+            bad + 2,
+            body[bad].len(),
+            header.len()
+        );
+    }
+    Ok((header, body))
+}
+
+/// The index of column `name` in `header`; `what` names the CSV in errors.
+fn csv_column(header: &[String], name: &str, what: &str) -> Result<usize> {
+    header
+        .iter()
+        .position(|h| h == name)
+        .with_context(|| format!("{what} has no column `{name}`"))
+}
+
+/// The columns of a pair's two image ids.
+fn pair_key(header: &[String], what: &str) -> Result<[usize; 2]> {
+    Ok([
+        csv_column(header, "image_id1", what)?,
+        csv_column(header, "image_id2", what)?,
+    ])
+}
+
+/// The AUC of column `c` (called `name`; negated for `cost`) over the `labelled` rows that have
+/// a value there, and how many do.
+fn column_auc(labelled: &[(&Vec<String>, bool)], c: usize, name: &str) -> Result<(f64, usize)> {
+    let sign = if name == "cost" { -1.0 } else { 1.0 };
+    let (values, classes): (Vec<f64>, Vec<bool>) = labelled
+        .iter()
+        .filter(|(r, _)| !r[c].is_empty())
+        .map(|(r, t)| {
+            Ok((
+                sign * r[c]
+                    .parse::<f64>()
+                    .with_context(|| format!("column {name}: `{}` is no number", r[c]))?,
+                *t,
+            ))
+        })
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
+    Ok((auc(&values, &classes).unwrap_or(f64::NAN), values.len()))
+}
+
 /// The AUC table of a `prune --scores` CSV against an `eval --labels` CSV (pairs joined by their
 /// image ids): per column, the AUC of true pairs over false ones (of -cost for `cost`, where lower
 /// is better) and how many pairs have a value; then how many true and false pairs were kept.
 pub fn csv_table(scores: &str, labels: &str) -> Result<String> {
-    let rows = |text: &str, what: &str| -> Result<(Vec<String>, Vec<Vec<String>>)> {
-        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-        let header: Vec<String> = lines
-            .next()
-            .with_context(|| format!("{what} is empty"))?
-            .split(',')
-            .map(str::to_string)
-            .collect();
-        let body = lines
-            .map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>())
-            .collect::<Vec<_>>();
-        if let Some(bad) = body.iter().position(|r| r.len() != header.len()) {
-            bail!(
-                "{what} line {}: {} fields, the header has {}",
-                bad + 2,
-                body[bad].len(),
-                header.len()
-            );
-        }
-        Ok((header, body))
-    };
-    let (score_header, score_rows) = rows(scores, "the scores CSV")?;
-    let (label_header, label_rows) = rows(labels, "the labels CSV")?;
-    let column = |header: &[String], name: &str, what: &str| -> Result<usize> {
-        header
-            .iter()
-            .position(|h| h == name)
-            .with_context(|| format!("{what} has no column `{name}`"))
-    };
-    let key = |header: &[String], what: &str| -> Result<[usize; 2]> {
-        Ok([
-            column(header, "image_id1", what)?,
-            column(header, "image_id2", what)?,
-        ])
-    };
-    let [a, b] = key(&label_header, "the labels CSV")?;
-    let truth_column = column(&label_header, "true_pair", "the labels CSV")?;
+    let (score_header, score_rows) = csv_rows(scores, "the scores CSV")?;
+    let (label_header, label_rows) = csv_rows(labels, "the labels CSV")?;
+    let [a, b] = pair_key(&label_header, "the labels CSV")?;
+    let truth_column = csv_column(&label_header, "true_pair", "the labels CSV")?;
     let truth: HashMap<(String, String), bool> = label_rows
         .iter()
         .map(|r| ((r[a].clone(), r[b].clone()), r[truth_column] == "1"))
         .collect();
-    let [sa, sb] = key(&score_header, "the scores CSV")?;
-    let kept_column = column(&score_header, "kept", "the scores CSV")?;
+    let [sa, sb] = pair_key(&score_header, "the scores CSV")?;
+    let kept_column = csv_column(&score_header, "kept", "the scores CSV")?;
     let labelled: Vec<(&Vec<String>, bool)> = score_rows
         .iter()
         .filter_map(|r| truth.get(&(r[sa].clone(), r[sb].clone())).map(|&t| (r, t)))
@@ -232,23 +260,8 @@ pub fn csv_table(scores: &str, labels: &str) -> Result<String> {
         if c == sa || c == sb || c == kept_column {
             continue;
         }
-        let sign = if name == "cost" { -1.0 } else { 1.0 };
-        let (values, classes): (Vec<f64>, Vec<bool>) = labelled
-            .iter()
-            .filter(|(r, _)| !r[c].is_empty())
-            .map(|(r, t)| {
-                Ok((
-                    sign * r[c]
-                        .parse::<f64>()
-                        .with_context(|| format!("column {name}: `{}` is no number", r[c]))?,
-                    *t,
-                ))
-            })
-            .collect::<Result<Vec<_>>>()?
-            .into_iter()
-            .unzip();
-        let auc = auc(&values, &classes).unwrap_or(f64::NAN);
-        writeln!(out, "{name:<28} {auc:>6.3} {:>18}", values.len())?;
+        let (auc, values) = column_auc(&labelled, c, name)?;
+        writeln!(out, "{name:<28} {auc:>6.3} {values:>18}")?;
     }
     let kept = |want: bool| {
         labelled

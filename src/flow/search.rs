@@ -305,155 +305,254 @@ impl SearchResult {
     }
 }
 
+/// Runs `rule` on a fresh `solver` of `problem`: augments to the fixed F, or until every
+/// criterion and every one of `checks` holds.
 fn run(
     solver: &mut ParametricSolver,
     problem: &SelectionProblem,
     rule: &FlowRule,
     checks: &[&dyn SelectionCheck],
 ) -> SearchResult {
-    let mut curve = vec![point(solver)];
     match *rule {
-        FlowRule::Fixed(f) => {
-            while solver.flow() < f && solver.augment().is_some() {
-                curve.push(point(solver));
-            }
-            SearchResult {
-                selection: solver.selection(),
-                criteria: Vec::new(),
-                capped: false,
-                curve,
-                beyond: Vec::new(),
-            }
-        }
+        FlowRule::Fixed(f) => run_fixed(solver, f),
         FlowRule::Criteria(criteria) => {
-            let (target_images, target_pairs) = targets(problem, &criteria);
-            let each = EachImage::new(problem, criteria.min_pairs_each);
-            let reachable_images = {
-                let mut has_pair = vec![false; problem.image_costs.len()];
-                for p in &problem.pairs {
-                    has_pair[p.i as usize] = true;
-                    has_pair[p.j as usize] = true;
-                }
-                has_pair.iter().filter(|&&b| b).count()
-            };
-            // Beyond this F the pair target is out of reach (pairs <= 2|E| - F).
-            let last_useful = 2 * problem.pairs.len() as u64 - target_pairs as u64;
-            let mut ever = (false, false);
-            let mut found = None;
-            // What held at the F before the one examined: images, pairs, each image's pairs.
-            let mut prev = (false, false, false);
-            // The caller's checks: the F from which they are next evaluated, and for each whether
-            // it ever failed and what it achieved at its last evaluation.
-            let mut next_check = 0u64;
-            let mut check_failed = vec![false; checks.len()];
-            let mut check_achieved = vec![0usize; checks.len()];
-            if target_images > reachable_images {
-                // Out of reach from the start: only the image criterion is to blame.
-                ever = (false, true);
-            } else {
-                loop {
-                    let p = *curve.last().unwrap();
-                    let images = p.images_selected >= target_images;
-                    let pairs = p.pairs_selected >= target_pairs;
-                    ever = (ever.0 || images, ever.1 || pairs);
-                    // The per-selection criteria are counted only once the cheap ones hold.
-                    let each_ok = images && pairs && each.met(solver) == each.target;
-                    if each_ok && p.flow >= next_check {
-                        let selected = if checks.is_empty() {
-                            Vec::new()
-                        } else {
-                            solver.selection().pairs
-                        };
-                        let mut all = true;
-                        for (k, c) in checks.iter().enumerate() {
-                            check_achieved[k] = c.achieved(&selected);
-                            if check_achieved[k] < c.target() {
-                                check_failed[k] = true;
-                                all = false;
-                            }
-                        }
-                        if all {
-                            found = Some(p);
-                            break;
-                        }
-                        next_check = p.flow + (p.flow / CHECK_STEP).max(1);
-                    }
-                    prev = (images, pairs, each_ok);
-                    if solver.flow() >= last_useful || solver.augment().is_none() {
-                        break;
-                    }
-                    curve.push(point(solver));
-                }
-            }
-            let status =
-                |name: &str, target: usize, achieved: usize, binding: bool| CriterionStatus {
-                    name: name.to_string(),
-                    target: target as f64,
-                    achieved: achieved as f64,
-                    met: achieved >= target,
-                    binding,
-                };
-            match found {
-                Some(p) => {
-                    // Binding: not met at F - 1 (none at F = 0, where nothing was needed).
-                    let first = p.flow == 0;
-                    let mut criteria = vec![
-                        status(
-                            "images",
-                            target_images,
-                            p.images_selected,
-                            !first && !prev.0,
-                        ),
-                        status("pairs", target_pairs, p.pairs_selected, !first && !prev.1),
-                    ];
-                    if each.active() {
-                        // Binding when the others held at F - 1 and it did not.
-                        let binding = !first && prev.0 && prev.1 && !prev.2;
-                        criteria.push(status("pairs_each", each.target, each.met(solver), binding));
-                    }
-                    for (k, c) in checks.iter().enumerate() {
-                        // Binding when the others held at F - 1 and it had failed before.
-                        let binding = !first && prev.2 && check_failed[k];
-                        criteria.push(status(c.name(), c.target(), check_achieved[k], binding));
-                    }
-                    SearchResult {
-                        selection: solver.selection(),
-                        criteria,
-                        capped: false,
-                        curve,
-                        beyond: Vec::new(),
-                    }
-                }
-                None => {
-                    // Binding: the criteria never met at any F examined; both if each was met
-                    // at some F but never together.
-                    let both = ever.0 && ever.1;
-                    let selection = full_selection(problem);
-                    let mut criteria = vec![
-                        status(
-                            "images",
-                            target_images,
-                            problem.image_costs.len(),
-                            both || !ever.0,
-                        ),
-                        status("pairs", target_pairs, problem.pairs.len(), both || !ever.1),
-                    ];
-                    if each.active() {
-                        criteria.push(status("pairs_each", each.target, each.target, false));
-                    }
-                    for (k, c) in checks.iter().enumerate() {
-                        // The full graph meets it (a check's contract); binding when it failed.
-                        criteria.push(status(c.name(), c.target(), c.target(), check_failed[k]));
-                    }
-                    SearchResult {
-                        selection,
-                        criteria,
-                        capped: true,
-                        curve,
-                        beyond: Vec::new(),
-                    }
-                }
+            let goal = Goal::new(problem, &criteria);
+            let walk = walk_to_goal(solver, problem, &goal, checks);
+            match walk.found {
+                Some(p) => met(solver, &goal, checks, walk, p),
+                None => capped(problem, &goal, checks, walk),
             }
         }
+    }
+}
+
+/// Augments to `f` (or as far as the network allows) and selects there.
+fn run_fixed(solver: &mut ParametricSolver, f: u64) -> SearchResult {
+    let mut curve = vec![point(solver)];
+    while solver.flow() < f && solver.augment().is_some() {
+        curve.push(point(solver));
+    }
+    SearchResult {
+        selection: solver.selection(),
+        criteria: Vec::new(),
+        capped: false,
+        curve,
+        beyond: Vec::new(),
+    }
+}
+
+/// What a criteria search must reach: the image and pair targets ([`targets`]) and each image's
+/// pairs.
+struct Goal {
+    /// Images to select.
+    images: usize,
+    /// Pairs to select.
+    pairs: usize,
+    /// The per-image criterion.
+    each: EachImage,
+}
+
+impl Goal {
+    fn new(problem: &SelectionProblem, criteria: &Criteria) -> Goal {
+        let (images, pairs) = targets(problem, criteria);
+        let each = EachImage::new(problem, criteria.min_pairs_each);
+        Goal {
+            images,
+            pairs,
+            each,
+        }
+    }
+}
+
+/// What the walk over F saw: the curve, the point where everything held, and what each criterion
+/// did on the way (which decides the ones that were binding).
+struct Walk {
+    /// Images and pairs selected at each F examined, from F = 0.
+    curve: Vec<CurvePoint>,
+    /// The first point where every criterion and check held; none if the search is capped.
+    found: Option<CurvePoint>,
+    /// What held at the F before the one examined: images, pairs, each image's pairs.
+    prev: (bool, bool, bool),
+    /// Whether the image and the pair target were met at any F examined.
+    ever: (bool, bool),
+    /// For each of the caller's checks, whether it ever failed.
+    check_failed: Vec<bool>,
+    /// For each of the caller's checks, what it achieved at its last evaluation.
+    check_achieved: Vec<usize>,
+}
+
+impl Walk {
+    /// Evaluates `checks` on the solver's current selection and records what each achieved;
+    /// true when all of them hold.
+    fn evaluate(&mut self, solver: &ParametricSolver, checks: &[&dyn SelectionCheck]) -> bool {
+        let selected = if checks.is_empty() {
+            Vec::new()
+        } else {
+            solver.selection().pairs
+        };
+        let mut all = true;
+        for (k, c) in checks.iter().enumerate() {
+            self.check_achieved[k] = c.achieved(&selected);
+            if self.check_achieved[k] < c.target() {
+                self.check_failed[k] = true;
+                all = false;
+            }
+        }
+        all
+    }
+}
+
+/// Images that have a pair: the only ones that can ever carry flow.
+fn reachable_images(problem: &SelectionProblem) -> usize {
+    let mut has_pair = vec![false; problem.image_costs.len()];
+    for p in &problem.pairs {
+        has_pair[p.i as usize] = true;
+        has_pair[p.j as usize] = true;
+    }
+    has_pair.iter().filter(|&&b| b).count()
+}
+
+/// Augments F = 0, 1, ... until `goal` and `checks` hold at F, or up to where the pair target is
+/// out of reach (see the module doc); the checks only once the rest holds, and not at every F
+/// ([`SelectionCheck`]).
+fn walk_to_goal(
+    solver: &mut ParametricSolver,
+    problem: &SelectionProblem,
+    goal: &Goal,
+    checks: &[&dyn SelectionCheck],
+) -> Walk {
+    let mut walk = Walk {
+        curve: vec![point(solver)],
+        found: None,
+        prev: (false, false, false),
+        ever: (false, false),
+        check_failed: vec![false; checks.len()],
+        check_achieved: vec![0usize; checks.len()],
+    };
+    if goal.images > reachable_images(problem) {
+        // Out of reach from the start: only the image criterion is to blame.
+        walk.ever = (false, true);
+        return walk;
+    }
+    // Beyond this F the pair target is out of reach (pairs <= 2|E| - F).
+    let last_useful = 2 * problem.pairs.len() as u64 - goal.pairs as u64;
+    // The F from which the caller's checks are next evaluated.
+    let mut next_check = 0u64;
+    loop {
+        let p = *walk.curve.last().unwrap();
+        let images = p.images_selected >= goal.images;
+        let pairs = p.pairs_selected >= goal.pairs;
+        walk.ever = (walk.ever.0 || images, walk.ever.1 || pairs);
+        // The per-selection criteria are counted only once the cheap ones hold.
+        let each_ok = images && pairs && goal.each.met(solver) == goal.each.target;
+        if each_ok && p.flow >= next_check {
+            if walk.evaluate(solver, checks) {
+                walk.found = Some(p);
+                break;
+            }
+            next_check = p.flow + (p.flow / CHECK_STEP).max(1);
+        }
+        walk.prev = (images, pairs, each_ok);
+        if solver.flow() >= last_useful || solver.augment().is_none() {
+            break;
+        }
+        walk.curve.push(point(solver));
+    }
+    walk
+}
+
+/// One criterion's status.
+fn status(name: &str, target: usize, achieved: usize, binding: bool) -> CriterionStatus {
+    CriterionStatus {
+        name: name.to_string(),
+        target: target as f64,
+        achieved: achieved as f64,
+        met: achieved >= target,
+        binding,
+    }
+}
+
+/// The result where every criterion held, at `p`: the solver's selection there.
+fn met(
+    solver: &ParametricSolver,
+    goal: &Goal,
+    checks: &[&dyn SelectionCheck],
+    walk: Walk,
+    p: CurvePoint,
+) -> SearchResult {
+    let (prev, each) = (walk.prev, &goal.each);
+    // Binding: not met at F - 1 (none at F = 0, where nothing was needed).
+    let first = p.flow == 0;
+    let mut criteria = vec![
+        status("images", goal.images, p.images_selected, !first && !prev.0),
+        status("pairs", goal.pairs, p.pairs_selected, !first && !prev.1),
+    ];
+    if each.active() {
+        // Binding when the others held at F - 1 and it did not.
+        let binding = !first && prev.0 && prev.1 && !prev.2;
+        criteria.push(status("pairs_each", each.target, each.met(solver), binding));
+    }
+    for (k, c) in checks.iter().enumerate() {
+        // Binding when the others held at F - 1 and it had failed before.
+        let binding = !first && prev.2 && walk.check_failed[k];
+        criteria.push(status(
+            c.name(),
+            c.target(),
+            walk.check_achieved[k],
+            binding,
+        ));
+    }
+    SearchResult {
+        selection: solver.selection(),
+        criteria,
+        capped: false,
+        curve: walk.curve,
+        beyond: Vec::new(),
+    }
+}
+
+/// The result where no F met the criteria: the full graph.
+fn capped(
+    problem: &SelectionProblem,
+    goal: &Goal,
+    checks: &[&dyn SelectionCheck],
+    walk: Walk,
+) -> SearchResult {
+    let ever = walk.ever;
+    // Binding: the criteria never met at any F examined; both if each was met at some F but
+    // never together.
+    let both = ever.0 && ever.1;
+    let mut criteria = vec![
+        status(
+            "images",
+            goal.images,
+            problem.image_costs.len(),
+            both || !ever.0,
+        ),
+        status("pairs", goal.pairs, problem.pairs.len(), both || !ever.1),
+    ];
+    if goal.each.active() {
+        criteria.push(status(
+            "pairs_each",
+            goal.each.target,
+            goal.each.target,
+            false,
+        ));
+    }
+    for (k, c) in checks.iter().enumerate() {
+        // The full graph meets it (a check's contract); binding when it failed.
+        criteria.push(status(
+            c.name(),
+            c.target(),
+            c.target(),
+            walk.check_failed[k],
+        ));
+    }
+    SearchResult {
+        selection: full_selection(problem),
+        criteria,
+        capped: true,
+        curve: walk.curve,
+        beyond: Vec::new(),
     }
 }

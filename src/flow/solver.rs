@@ -124,6 +124,161 @@ fn out_node(i: usize) -> usize {
     2 * i + 2
 }
 
+/// Each image's degree (pairs it is in), after checking the problem as [`ParametricSolver::new`]
+/// says it panics.
+fn image_degrees(problem: &SelectionProblem) -> Vec<u32> {
+    let n = problem.image_costs.len();
+    let m = problem.pairs.len();
+    assert!(
+        2 * (m as u64) + 2 * (n as u64) < (i32::MAX as u64) && 2 * (n as u64) + 2 < NONE as u64,
+        "selection network too large for u32 indices ({n} images, {m} pairs)"
+    );
+    for (i, &c) in problem.image_costs.iter().enumerate() {
+        assert!(
+            (-1.0..=0.0).contains(&c),
+            "image {i}: cost {c} outside [-1, 0]"
+        );
+    }
+    let mut deg = vec![0u32; n];
+    for (k, p) in problem.pairs.iter().enumerate() {
+        assert!(
+            p.i < p.j && (p.j as usize) < n,
+            "pair {k}: indices ({}, {}) not i < j < {n}",
+            p.i,
+            p.j
+        );
+        assert!(
+            (-1.0..=0.0).contains(&p.cost),
+            "pair {k}: cost {} outside [-1, 0]",
+            p.cost
+        );
+        deg[p.i as usize] += 1;
+        deg[p.j as usize] += 1;
+    }
+    deg
+}
+
+/// Where each node's residual arcs start in the arc array (`first`, one more entry than nodes).
+fn arc_offsets(problem: &SelectionProblem, deg: &[u32]) -> Vec<u32> {
+    let num_nodes = 2 * deg.len() + 2;
+    // Out-degree in the residual network: in_i has its image arc plus one reverse pair arc
+    // per pair (k, i); out_i has the reverse image arc plus one pair arc per pair (i, j).
+    let mut count = vec![0u32; num_nodes + 1];
+    for (i, &d) in deg.iter().enumerate() {
+        if d > 0 {
+            count[in_node(i)] += 1;
+            count[out_node(i)] += 1;
+        }
+    }
+    for p in &problem.pairs {
+        count[out_node(p.i as usize)] += 1;
+        count[in_node(p.j as usize)] += 1;
+    }
+    let mut first = vec![0u32; num_nodes + 1];
+    for v in 0..num_nodes {
+        first[v + 1] = first[v] + count[v];
+    }
+    first
+}
+
+/// The residual arcs at zero flow, each with its reverse, at the offsets `first`; and the arc of
+/// each image (`NONE` for an image without pairs) and of each pair.
+fn place_arcs(
+    problem: &SelectionProblem,
+    deg: &[u32],
+    first: &[u32],
+) -> (Vec<Arc>, Vec<u32>, Vec<u32>) {
+    let (n, num_nodes) = (deg.len(), first.len() - 1);
+    let num_arcs = first[num_nodes] as usize;
+    let mut arcs = vec![
+        Arc {
+            head: 0,
+            rev: 0,
+            cap: 0,
+            cost: 0
+        };
+        num_arcs
+    ];
+    let mut next: Vec<u32> = first[..num_nodes].to_vec();
+    let mut place = |arcs: &mut Vec<Arc>, u: usize, v: usize, cap: u32, cost: i32| -> u32 {
+        let a = next[u];
+        let b = next[v];
+        next[u] += 1;
+        next[v] += 1;
+        arcs[a as usize] = Arc {
+            head: v as u32,
+            rev: b,
+            cap,
+            cost,
+        };
+        arcs[b as usize] = Arc {
+            head: u as u32,
+            rev: a,
+            cap: 0,
+            cost: -cost,
+        };
+        a
+    };
+    let mut image_arc = vec![NONE; n];
+    for i in 0..n {
+        if deg[i] > 0 {
+            let c = scale_cost(problem.image_costs[i]) as i32;
+            image_arc[i] = place(&mut arcs, in_node(i), out_node(i), deg[i], c);
+        }
+    }
+    let pair_arc: Vec<u32> = problem
+        .pairs
+        .iter()
+        .map(|p| {
+            let c = scale_cost(p.cost) as i32;
+            place(
+                &mut arcs,
+                out_node(p.i as usize),
+                in_node(p.j as usize),
+                1,
+                c,
+            )
+        })
+        .collect();
+    (arcs, image_arc, pair_arc)
+}
+
+/// Node potentials at zero flow: the exact shortest distances from s, in topological order s,
+/// in_0, out_0, ..., t (so every residual arc starts with a reduced cost >= 0).
+fn initial_potentials(deg: &[u32], first: &[u32], arcs: &[Arc], image_arc: &[u32]) -> Vec<Node> {
+    let (n, num_nodes) = (deg.len(), first.len() - 1);
+    let mut nodes = vec![
+        Node {
+            pi: 0,
+            dist: INF,
+            pred: NONE,
+            heap_pos: NONE,
+        };
+        num_nodes
+    ];
+    let t = num_nodes - 1;
+    let mut pi_t = 0i64;
+    for i in 0..n {
+        if deg[i] == 0 {
+            continue;
+        }
+        let u = in_node(i);
+        let mut p = 0i64; // via the source arc
+        for a in &arcs[first[u] as usize..first[u + 1] as usize] {
+            if (a.head as usize) < u {
+                // reverse pair arc in_i -> out_k: the pair arc out_k -> in_i costs -a.cost
+                p = p.min(nodes[a.head as usize].pi - a.cost as i64);
+            }
+        }
+        nodes[u].pi = p;
+        let po = p + arcs[image_arc[i] as usize].cost as i64;
+        nodes[out_node(i)].pi = po;
+        pi_t = pi_t.min(po);
+    }
+    nodes[t].pi = pi_t;
+    nodes
+}
+
 impl ParametricSolver {
     /// Builds the network at zero flow.
     ///
@@ -131,134 +286,11 @@ impl ParametricSolver {
     /// range, or the network exceeds the u32 index limits.
     pub fn new(problem: &SelectionProblem) -> Self {
         let n = problem.image_costs.len();
-        let m = problem.pairs.len();
-        assert!(
-            2 * (m as u64) + 2 * (n as u64) < (i32::MAX as u64) && 2 * (n as u64) + 2 < NONE as u64,
-            "selection network too large for u32 indices ({n} images, {m} pairs)"
-        );
-        for (i, &c) in problem.image_costs.iter().enumerate() {
-            assert!(
-                (-1.0..=0.0).contains(&c),
-                "image {i}: cost {c} outside [-1, 0]"
-            );
-        }
-        let mut deg = vec![0u32; n];
-        for (k, p) in problem.pairs.iter().enumerate() {
-            assert!(
-                p.i < p.j && (p.j as usize) < n,
-                "pair {k}: indices ({}, {}) not i < j < {n}",
-                p.i,
-                p.j
-            );
-            assert!(
-                (-1.0..=0.0).contains(&p.cost),
-                "pair {k}: cost {} outside [-1, 0]",
-                p.cost
-            );
-            deg[p.i as usize] += 1;
-            deg[p.j as usize] += 1;
-        }
+        let deg = image_degrees(problem);
         let num_nodes = 2 * n + 2;
-        // Out-degree in the residual network: in_i has its image arc plus one reverse pair arc
-        // per pair (k, i); out_i has the reverse image arc plus one pair arc per pair (i, j).
-        let mut count = vec![0u32; num_nodes + 1];
-        for (i, &d) in deg.iter().enumerate() {
-            if d > 0 {
-                count[in_node(i)] += 1;
-                count[out_node(i)] += 1;
-            }
-        }
-        for p in &problem.pairs {
-            count[out_node(p.i as usize)] += 1;
-            count[in_node(p.j as usize)] += 1;
-        }
-        let mut first = vec![0u32; num_nodes + 1];
-        for v in 0..num_nodes {
-            first[v + 1] = first[v] + count[v];
-        }
-        let num_arcs = first[num_nodes] as usize;
-        let mut arcs = vec![
-            Arc {
-                head: 0,
-                rev: 0,
-                cap: 0,
-                cost: 0
-            };
-            num_arcs
-        ];
-        let mut next: Vec<u32> = first[..num_nodes].to_vec();
-        let mut place = |arcs: &mut Vec<Arc>, u: usize, v: usize, cap: u32, cost: i32| -> u32 {
-            let a = next[u];
-            let b = next[v];
-            next[u] += 1;
-            next[v] += 1;
-            arcs[a as usize] = Arc {
-                head: v as u32,
-                rev: b,
-                cap,
-                cost,
-            };
-            arcs[b as usize] = Arc {
-                head: u as u32,
-                rev: a,
-                cap: 0,
-                cost: -cost,
-            };
-            a
-        };
-        let mut image_arc = vec![NONE; n];
-        for i in 0..n {
-            if deg[i] > 0 {
-                let c = scale_cost(problem.image_costs[i]) as i32;
-                image_arc[i] = place(&mut arcs, in_node(i), out_node(i), deg[i], c);
-            }
-        }
-        let pair_arc: Vec<u32> = problem
-            .pairs
-            .iter()
-            .map(|p| {
-                let c = scale_cost(p.cost) as i32;
-                place(
-                    &mut arcs,
-                    out_node(p.i as usize),
-                    in_node(p.j as usize),
-                    1,
-                    c,
-                )
-            })
-            .collect();
-
-        let mut nodes = vec![
-            Node {
-                pi: 0,
-                dist: INF,
-                pred: NONE,
-                heap_pos: NONE,
-            };
-            num_nodes
-        ];
-        // Exact shortest distances from s in topological order s, in_0, out_0, ..., t.
-        let t = num_nodes - 1;
-        let mut pi_t = 0i64;
-        for i in 0..n {
-            if deg[i] == 0 {
-                continue;
-            }
-            let u = in_node(i);
-            let mut p = 0i64; // via the source arc
-            for a in &arcs[first[u] as usize..first[u + 1] as usize] {
-                if (a.head as usize) < u {
-                    // reverse pair arc in_i -> out_k: the pair arc out_k -> in_i costs -a.cost
-                    p = p.min(nodes[a.head as usize].pi - a.cost as i64);
-                }
-            }
-            nodes[u].pi = p;
-            let po = p + arcs[image_arc[i] as usize].cost as i64;
-            nodes[out_node(i)].pi = po;
-            pi_t = pi_t.min(po);
-        }
-        nodes[t].pi = pi_t;
-
+        let first = arc_offsets(problem, &deg);
+        let (arcs, image_arc, pair_arc) = place_arcs(problem, &deg, &first);
+        let nodes = initial_potentials(&deg, &first, &arcs, &image_arc);
         let max_flow = deg.iter().map(|&d| d as u64).sum();
         ParametricSolver {
             n,
@@ -381,6 +413,10 @@ impl ParametricSolver {
     /// Dijkstra on reduced costs from s, stopping once t is settled. Leaves labels in `nodes`,
     /// the settled nodes (excluding t) in `settled`, the labelled ones in `touched`, and the
     /// out-node before t in `t_pred`. Returns d(t), or `None` if t is unreachable.
+    ///
+    /// One algorithm, read whole: the seeding from s, the heap loop with its early stop at t and
+    /// the reset on failure share the scratch borrowed at the top; split, each step would take
+    /// them all.
     fn dijkstra(&mut self) -> Option<i64> {
         let t = self.nodes.len() - 1;
         let Self {

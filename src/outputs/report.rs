@@ -2,6 +2,7 @@
 
 use crate::flow::search::CriterionStatus;
 use crate::named::Named;
+use crate::priors::PriorValues;
 use crate::scene::view_graph::{GraphStats, ViewGraph};
 use crate::selection::arc_rules::Listed;
 use crate::selection::parameters::Parameters;
@@ -132,56 +133,12 @@ impl Report {
     ) -> Report {
         let selection = &plan.search.selection;
         let after = ViewGraph::build(&plan.images, &plan.selected_pairs(), 1);
-        let names: HashMap<u32, &str> = plan
-            .images
-            .iter()
-            .map(|im| (im.image_id, im.name.as_str()))
-            .collect();
-        let mut isolated: Vec<String> = plan
-            .graph
-            .isolated
-            .iter()
-            .map(|id| names[id].to_string())
-            .collect();
-        isolated.sort();
-        let summarise = |fitness: &[crate::priors::PriorValues], kept: &[bool], applies_to| {
-            let mean_where = |values: &[f64], want: bool| {
-                mean(
-                    values
-                        .iter()
-                        .zip(kept)
-                        .filter(|(_, &k)| k == want)
-                        .map(|(&v, _)| v),
-                )
-            };
-            fitness
-                .iter()
-                .map(|f| PriorSummary {
-                    name: f.prior.name(),
-                    applies_to,
-                    mean_fitness: mean(f.values.iter().copied()),
-                    mean_fitness_selected: mean_where(&f.values, true),
-                    mean_fitness_removed: mean_where(&f.values, false),
-                })
-                .collect::<Vec<_>>()
-        };
-        let mut priors = summarise(&plan.costs.image_fitness, &selection.images, "images");
-        priors.extend(summarise(
+        let mut priors = prior_summaries(&plan.costs.image_fitness, &selection.images, "images");
+        priors.extend(prior_summaries(
             &plan.costs.pair_fitness,
             &selection.pairs,
             "pairs",
         ));
-        let order = &plan.order;
-        let window = crate::selection::capture_order::SEQUENTIAL_WINDOW;
-        let share = |kept: Option<&[bool]>| {
-            let edges = plan.graph.edges.iter().enumerate();
-            order.share_within(
-                edges
-                    .filter(|(k, _)| kept.is_none_or(|kept| kept[*k]))
-                    .map(|(_, e)| (e.i, e.j)),
-                window,
-            )
-        };
         Report {
             schema_version: SCHEMA_VERSION,
             tool_version: env!("CARGO_PKG_VERSION"),
@@ -194,7 +151,7 @@ impl Report {
             images_total: plan.images.len(),
             images_in_view_graph: plan.graph.num_vertices(),
             images_selected: selection.images.iter().filter(|&&s| s).count(),
-            images_isolated: isolated,
+            images_isolated: isolated_names(plan),
             pairs_verified: plan.pairs.len(),
             pairs_total: plan.graph.edges.len(),
             pairs_selected: selection.pairs.iter().filter(|&&s| s).count(),
@@ -207,16 +164,7 @@ impl Report {
             completion: plan.completion.clone(),
             priors,
             overrides: plan.overrides.clone(),
-            order: OrderReport {
-                name: order.order,
-                selected_within_window: share(Some(&selection.pairs)),
-                view_graph_within_window: share(None),
-                window,
-                images_without_time: order.images_without_time,
-                sequence_window: parameters.capture.sequence_window,
-                keep_neighbours: parameters.arc_rules.keep_neighbours,
-                neighbours_kept: plan.neighbours_kept,
-            },
+            order: OrderReport::new(plan, parameters),
             outputs: Outputs::default(),
             timings: plan.timings.clone(),
         }
@@ -224,32 +172,7 @@ impl Report {
 
     /// Two or three lines for a person.
     pub fn summary(&self) -> String {
-        let pct = |a: usize, b: usize| {
-            if b == 0 {
-                0.0
-            } else {
-                100.0 * a as f64 / b as f64
-            }
-        };
-        let binding = self
-            .criteria
-            .iter()
-            .find(|c| c.binding)
-            .map(|c| c.name.as_str());
-        let why = match (self.capped, binding) {
-            (true, _) => "no flow met the criteria: full graph kept".to_string(),
-            (false, Some(name)) => format!("set by the {name} criterion"),
-            (false, None) => "fixed by --flow".to_string(),
-        };
-        let mut s = format!(
-            "selected {} of {} pairs ({:.1}%) and {} of {} images at flow F = {} ({why})\n",
-            self.pairs_selected,
-            self.pairs_total,
-            pct(self.pairs_selected, self.pairs_total),
-            self.images_selected,
-            self.images_in_view_graph,
-            self.flow,
-        );
+        let mut s = self.headline();
         if let Some(c) = &self.completion {
             s += &format!(
                 "track completion: the flow kept {} pairs; {} added from the strongest spanning \
@@ -276,13 +199,47 @@ impl Report {
                 ""
             }
         );
+        s + &self.notes()
+    }
+
+    /// The summary's first line: what was selected, at which F, and what set it.
+    fn headline(&self) -> String {
+        let pct = |a: usize, b: usize| {
+            if b == 0 {
+                0.0
+            } else {
+                100.0 * a as f64 / b as f64
+            }
+        };
+        let binding = self
+            .criteria
+            .iter()
+            .find(|c| c.binding)
+            .map(|c| c.name.as_str());
+        let why = match (self.capped, binding) {
+            (true, _) => "no flow met the criteria: full graph kept".to_string(),
+            (false, Some(name)) => format!("set by the {name} criterion"),
+            (false, None) => "fixed by --flow".to_string(),
+        };
+        format!(
+            "selected {} of {} pairs ({:.1}%) and {} of {} images at flow F = {} ({why})\n",
+            self.pairs_selected,
+            self.pairs_total,
+            pct(self.pairs_selected, self.pairs_total),
+            self.images_selected,
+            self.images_in_view_graph,
+            self.flow,
+        )
+    }
+
+    /// The summary's last lines, each where it applies: the order, the overrides, the close
+    /// neighbours, the isolated images.
+    fn notes(&self) -> String {
+        let mut s = String::new();
         if let Some(share) = self.order.selected_within_window {
             s += &format!(
                 "\npair arcs in {} order: {:.0}% of the selected pairs are within {} positions",
-                serde_json::to_value(self.order.name)
-                    .unwrap_or_default()
-                    .as_str()
-                    .unwrap_or(""),
+                self.order.name.name(),
                 100.0 * share,
                 self.order.window
             );
@@ -315,6 +272,72 @@ impl Report {
 /// Mean of the values that are numbers: a NaN fitness means the prior does not apply to that item
 /// (no triangle, no second motion), and the cost leaves it out too. No items: 0; items but none
 /// the prior applies to: NaN (null in the JSON).
+/// Names of the images without a view-graph edge, sorted.
+fn isolated_names(plan: &Plan) -> Vec<String> {
+    let names: HashMap<u32, &str> = plan
+        .images
+        .iter()
+        .map(|im| (im.image_id, im.name.as_str()))
+        .collect();
+    let mut isolated: Vec<String> = plan
+        .graph
+        .isolated
+        .iter()
+        .map(|id| names[id].to_string())
+        .collect();
+    isolated.sort();
+    isolated
+}
+
+/// Each prior's mean fitness over all images (or pairs), the kept and the removed ones.
+fn prior_summaries(
+    fitness: &[PriorValues],
+    kept: &[bool],
+    applies_to: &'static str,
+) -> Vec<PriorSummary> {
+    let mean_where = |values: &[f64], want: bool| {
+        let values = values.iter().zip(kept);
+        mean(values.filter(|(_, &k)| k == want).map(|(&v, _)| v))
+    };
+    fitness
+        .iter()
+        .map(|f| PriorSummary {
+            name: f.prior.name(),
+            applies_to,
+            mean_fitness: mean(f.values.iter().copied()),
+            mean_fitness_selected: mean_where(&f.values, true),
+            mean_fitness_removed: mean_where(&f.values, false),
+        })
+        .collect()
+}
+
+impl OrderReport {
+    /// The order `plan` followed and how sequential its selection is in it.
+    fn new(plan: &Plan, parameters: &Parameters) -> OrderReport {
+        let order = &plan.order;
+        let window = crate::selection::capture_order::SEQUENTIAL_WINDOW;
+        let share = |kept: Option<&[bool]>| {
+            let edges = plan.graph.edges.iter().enumerate();
+            order.share_within(
+                edges
+                    .filter(|(k, _)| kept.is_none_or(|kept| kept[*k]))
+                    .map(|(_, e)| (e.i, e.j)),
+                window,
+            )
+        };
+        OrderReport {
+            name: order.order,
+            selected_within_window: share(Some(&plan.search.selection.pairs)),
+            view_graph_within_window: share(None),
+            window,
+            images_without_time: order.images_without_time,
+            sequence_window: parameters.capture.sequence_window,
+            keep_neighbours: parameters.arc_rules.keep_neighbours,
+            neighbours_kept: plan.neighbours_kept,
+        }
+    }
+}
+
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (mut sum, mut n, mut items) = (0.0, 0usize, 0usize);
     for v in values {

@@ -24,7 +24,7 @@
 //! meet there. The forest then only joins the pieces the sequence leaves apart.
 
 use super::tracks::Tracks;
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::view_graph::{Edge, ViewGraph};
 use crate::scene::{Scene, Sequence};
 use petgraph::unionfind::UnionFind;

@@ -2,7 +2,7 @@
 //! favour images that connect otherwise separate groups (point-of-view bias in photo
 //! collections); such bridging images have a *low* coefficient, so the fitness is its complement.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 
 /// 1 − local clustering coefficient of every vertex: 1 for images that bridge unlinked groups.

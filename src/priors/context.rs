@@ -17,7 +17,7 @@
 //! vector names every other image).
 
 use super::overlap::convex_hull;
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::Scene;
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashSet};

@@ -1,6 +1,6 @@
 //! Image prior: degree in the view graph. Well-connected images support long tracks.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 
 /// Number of view-graph edges of every vertex.

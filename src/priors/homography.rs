@@ -8,7 +8,7 @@
 //! RANSAC fit of our own took 80% of a 100K-pair prune. Pairs the database stores no homography
 //! for get one fitted (RANSAC) to their normalised inliers.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::geometry::pose::{estimate_homography, homography_inliers};
 use crate::geometry::view_geometry::ViewGeometry;
 use crate::scene::Scene;

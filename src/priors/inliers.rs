@@ -1,6 +1,6 @@
 //! Pair prior: number of verified inlier correspondences.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::Scene;
 
 /// Number of verified inliers of every edge.

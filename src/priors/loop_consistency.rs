@@ -8,7 +8,7 @@
 //! centres always are): rotation chaining cannot see a copy that is only translated, and a raw
 //! count favours pairs in dense regions whatever their truth.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::geometry::pose::{rotation_angle_deg, RelativePose};
 use crate::scene::Scene;
 use nalgebra::Rotation3;

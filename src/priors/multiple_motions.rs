@@ -4,7 +4,7 @@
 //! is the angle of R1ᵀR2, `motion_position` the angle between the translation directions
 //! (degrees); both are NaN (left out of the cost) where no second motion is found.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::geometry::pose::{direction_angle_deg, estimate_pose, rotation_angle_deg, RelativePose};
 use crate::geometry::view_geometry::ViewGeometry;
 use crate::scene::Scene;

@@ -2,7 +2,7 @@
 //! inlier keypoints divided by the image area. Pairs whose matches cover little of the images
 //! constrain the geometry poorly.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::Scene;
 use rayon::prelude::*;
 

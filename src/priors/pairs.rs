@@ -2,7 +2,8 @@
 //! cameras, focal-length estimation and a relative pose per pair; multiple motions also need the
 //! raw matches. [`needs`] tells the pipeline which of those to load into the [`Scene`].
 
-use super::{backbone_tracks, triangulation_angle, unique_tracks, Prior, PriorValues};
+use super::values::{Prior, PriorValues};
+use super::{backbone_tracks, triangulation_angle, unique_tracks};
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
 use crate::geometry::camera::CameraModel;
 use crate::geometry::focal::{self, FundamentalPair};

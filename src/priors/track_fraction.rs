@@ -1,7 +1,7 @@
 //! Image prior: fraction of an image's keypoints that are inliers of at least one view-graph
 //! edge, i.e. that take part in a track. Images with many observations anchor the reconstruction.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::Scene;
 
 /// Share in [0, 1] of each vertex's keypoints that are an inlier of some edge (0 without

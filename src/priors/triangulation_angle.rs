@@ -3,7 +3,7 @@
 //! 45°, stays high to 90° and falls to 120°. Pairs without a pose, or whose points all fail
 //! triangulation, get 0.
 
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::geometry::pose::{direction_angle_deg, triangulate};
 use crate::geometry::view_geometry::ViewGeometry;
 use crate::scene::Scene;

@@ -11,7 +11,7 @@
 //! (docs/priors.md): factor 4 separates better than 2 or 3 and as well as a smooth 1/length.
 
 use super::tracks::Tracks;
-use super::{Prior, PriorValues};
+use super::values::{Prior, PriorValues};
 use crate::scene::Scene;
 
 /// A track with more observations than this many times the median is confusing.

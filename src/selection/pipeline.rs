@@ -16,7 +16,7 @@ use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::{Scene, Sequence};
-use crate::selection::arc_rules::{self, ArcRules, Listed, Overrides};
+use crate::selection::arc_rules::{self, ArcRules, Listed, Overrides, Resolved};
 use crate::selection::capture_order::{self, CaptureOrder};
 use crate::selection::parameters::{Flow, Parameters};
 use crate::selection::preset::Preset;
@@ -131,7 +131,7 @@ pub fn plan(
         pairs,
         graph,
     } = read(db, parameters.min_num_matches)?;
-    let mut rules = overrides.resolve(&images, &graph, parameters.min_num_matches)?;
+    let rules = overrides.resolve(&images, &graph, parameters.min_num_matches)?;
     let to_compute = (parameters.cost_model).pair_priors_to_compute(extras.unweighted_priors);
     let mut scene = load_scene(db, &graph, &pairs, &images, cameras, &to_compute, stage)?;
     let order = capture_order::compute(&parameters.capture, &graph, &images, &pairs)?;
@@ -153,39 +153,19 @@ pub fn plan(
     // 4. Arc rules: close neighbours kept, pairs below the fitness floor removed.
     stage("solving the min-cost flow selection");
     let t = Instant::now();
-    let rule = parameters.flow.rule();
-    let neighbours_kept = arc_rules::keep_neighbours(
-        &mut rules.edges,
-        &graph,
-        &order,
-        parameters.arc_rules.keep_neighbours,
-    );
-    let min_pair_fitness = parameters.cost_model.min_pair_fitness;
-    let floor = arc_rules::fitness_floor(min_pair_fitness, &rule, &graph, &costs.pair_costs);
-    let below_fitness_floor =
-        arc_rules::remove_below_floor(&mut rules.edges, &costs.pair_costs, floor);
-    let network = problem(&graph, &costs, &order)
-        .restrict(&order.by_rank(&rules.forbidden_vertices), &rules.edges);
+    let ruled = apply_arc_rules(parameters, &rules, &graph, &costs, &order);
 
     // 5. The flow search, and 6. the track completion.
-    let mut search = search_flow(&network, &parameters.flow, extras.curve_factor, &order);
-    let completion = complete_tracks(
-        &scene,
-        &network,
-        &graph,
-        &mut search,
+    let mut search = search_flow(
+        &ruled.network,
         &parameters.flow,
-        stage,
+        extras.curve_factor,
+        &order,
     );
+    let completion = complete_tracks(&scene, &ruled.network, &mut search, &parameters.flow, stage);
     timings.solve = t.elapsed().as_secs_f64();
 
-    let invalidate = graph
-        .edges
-        .iter()
-        .zip(&search.selection.pairs)
-        .filter(|(_, &kept)| !kept)
-        .map(|(e, _)| pair_id(pairs[e.pair].image_id1, pairs[e.pair].image_id2))
-        .collect();
+    let invalidate = unselected_pair_ids(&graph, &pairs, &search.selection.pairs);
     timings.total = started.elapsed().as_secs_f64();
     Ok(Plan {
         images,
@@ -195,14 +175,14 @@ pub fn plan(
         pair_priors: pair_priors.values,
         focal_estimates: pair_priors.focal_estimates,
         costs,
-        network,
+        network: ruled.network,
         overrides: rules.listed,
-        neighbours_kept,
+        neighbours_kept: ruled.neighbours_kept,
         order,
         search,
         completion,
-        fitness_floor: floor,
-        below_fitness_floor,
+        fitness_floor: ruled.fitness_floor,
+        below_fitness_floor: ruled.below_fitness_floor,
         invalidate,
         timings,
         data_version,
@@ -276,6 +256,51 @@ fn read(db: &Database, min_num_matches: usize) -> Result<Read> {
     })
 }
 
+/// What stage 4 made of the view graph: the network the flow runs on, and what the rules did.
+struct Ruled {
+    network: Restriction,
+    neighbours_kept: usize,
+    fitness_floor: f64,
+    below_fitness_floor: usize,
+}
+
+/// Stage 4: to the overrides' rules, adds the close neighbours kept and the pairs below the
+/// fitness floor, and restricts the paper's network by them.
+fn apply_arc_rules(
+    parameters: &Parameters,
+    overrides: &Resolved,
+    graph: &ViewGraph,
+    costs: &Costs,
+    order: &CaptureOrder,
+) -> Ruled {
+    let mut edges = overrides.edges.clone();
+    let window = parameters.arc_rules.keep_neighbours;
+    let neighbours_kept = arc_rules::keep_neighbours(&mut edges, graph, order, window);
+    let floor = parameters.cost_model.min_pair_fitness;
+    let rule = parameters.flow.rule();
+    let floor = arc_rules::fitness_floor(floor, &rule, graph, &costs.pair_costs);
+    let below_fitness_floor = arc_rules::remove_below_floor(&mut edges, &costs.pair_costs, floor);
+    let network = problem(graph, costs, order)
+        .restrict(&order.by_rank(&overrides.forbidden_vertices), &edges);
+    Ruled {
+        network,
+        neighbours_kept,
+        fitness_floor: floor,
+        below_fitness_floor,
+    }
+}
+
+/// The pair_ids of the view-graph edges the selection leaves out: what the rewrite invalidates.
+fn unselected_pair_ids(graph: &ViewGraph, pairs: &[VerifiedPair], kept: &[bool]) -> Vec<u64> {
+    graph
+        .edges
+        .iter()
+        .zip(kept)
+        .filter(|(_, &kept)| !kept)
+        .map(|(e, _)| pair_id(pairs[e.pair].image_id1, pairs[e.pair].image_id2))
+        .collect()
+}
+
 /// Stage 5: the flow search on the network, its selection mapped back to the whole view graph
 /// (kept pairs added, images by vertex).
 fn search_flow(
@@ -304,7 +329,6 @@ fn search_flow(
 fn complete_tracks(
     scene: &Scene,
     network: &Restriction,
-    graph: &ViewGraph,
     search: &mut SearchResult,
     flow: &Flow,
     stage: &dyn Fn(&str),
@@ -319,7 +343,8 @@ fn complete_tracks(
     let selection = &mut search.selection;
     let done =
         track_completion::complete(scene, network, &mut selection.pairs, &settings.completion);
-    for (e, _) in graph.edges.iter().zip(&selection.pairs).filter(|(_, &k)| k) {
+    let edges = scene.graph.edges.iter();
+    for (e, _) in edges.zip(&selection.pairs).filter(|(_, &k)| k) {
         selection.images[e.i as usize] = true;
         selection.images[e.j as usize] = true;
     }

@@ -225,7 +225,6 @@ pub fn complete(
     needs: &Needs,
 ) -> Completion {
     let selectable = restriction.expand_pairs(&vec![true; restriction.problem.pairs.len()]);
-    let edges = scene.graph.edges.len();
     let mut full = TrackSet::build(scene, |e| selectable[e] || kept[e]);
     let mut tracks = TrackSet::build(scene, |e| kept[e]);
     let mut done = Completion {
@@ -234,67 +233,119 @@ pub fn complete(
         track_length_flow: tracks.mean_length(),
         ..Completion::default()
     };
-    let add = |tracks: &mut TrackSet, kept: &mut [bool], e: usize| {
-        kept[e] = true;
-        tracks.add_edge(scene, e);
-    };
-
     if needs.spanning_forests > 0 {
-        // Kruskal, strongest first (ties to the lower edge index), once per forest on the pairs
-        // the earlier forests left; the forced pairs count as candidates too, so a weak forced
-        // pair does not hide a strong one across the same cut.
-        let mut order: Vec<usize> = (0..edges).filter(|&e| selectable[e] || kept[e]).collect();
-        // Counting an edge's inliers walks them: once per edge, not once per comparison.
-        order.sort_by_cached_key(|&e| (Reverse(scene.edge_inliers(e).count()), e));
-        let mut in_forest = vec![false; edges];
-        for _ in 0..needs.spanning_forests {
-            let mut forest = UnionFind::<u32>::new(scene.graph.num_vertices());
-            for &e in &order {
-                let ends = &scene.graph.edges[e];
-                if in_forest[e] || !forest.union(ends.i, ends.j) {
-                    continue;
-                }
-                in_forest[e] = true;
-                if !kept[e] {
-                    add(&mut tracks, kept, e);
-                    done.pairs_added_for_spanning_forests += 1;
-                }
-            }
-        }
+        done.pairs_added_for_spanning_forests = add_spanning_forests(
+            scene,
+            &selectable,
+            kept,
+            &mut tracks,
+            needs.spanning_forests,
+        );
     }
-
     if needs.min_track_observations > 0 {
         let vertices = scene.graph.num_vertices();
         let need = image_needs(&mut full, vertices, needs.min_track_observations);
-        let mut incident = vec![Vec::new(); vertices];
-        for (k, e) in scene.graph.edges.iter().enumerate() {
-            if selectable[k] {
-                incident[e.i as usize].push(k);
-                incident[e.j as usize].push(k);
+        (done.images_short, done.pairs_added_for_images) =
+            add_for_images(scene, &selectable, kept, &mut tracks, &need);
+    }
+    let target = needs.min_track_length_ratio * done.track_length_full;
+    done.pairs_added_for_track_length =
+        add_for_track_length(scene, &selectable, kept, &mut tracks, target);
+    done.track_length = tracks.mean_length();
+    done
+}
+
+/// Selects edge `e`: keeps it and joins the tracks its inliers link.
+fn keep(scene: &Scene, tracks: &mut TrackSet, kept: &mut [bool], e: usize) {
+    kept[e] = true;
+    tracks.add_edge(scene, e);
+}
+
+/// Need 1: keeps the pairs of `forests` maximum spanning forests by inliers; returns how many
+/// it added.
+fn add_spanning_forests(
+    scene: &Scene,
+    selectable: &[bool],
+    kept: &mut [bool],
+    tracks: &mut TrackSet,
+    forests: usize,
+) -> usize {
+    let edges = scene.graph.edges.len();
+    let mut added = 0;
+    // Kruskal, strongest first (ties to the lower edge index), once per forest on the pairs
+    // the earlier forests left; the forced pairs count as candidates too, so a weak forced
+    // pair does not hide a strong one across the same cut.
+    let mut order: Vec<usize> = (0..edges).filter(|&e| selectable[e] || kept[e]).collect();
+    // Counting an edge's inliers walks them: once per edge, not once per comparison.
+    order.sort_by_cached_key(|&e| (Reverse(scene.edge_inliers(e).count()), e));
+    let mut in_forest = vec![false; edges];
+    for _ in 0..forests {
+        let mut forest = UnionFind::<u32>::new(scene.graph.num_vertices());
+        for &e in &order {
+            let ends = &scene.graph.edges[e];
+            if in_forest[e] || !forest.union(ends.i, ends.j) {
+                continue;
             }
-        }
-        for v in 0..vertices {
-            let mut short = true;
-            while tracks.observations_on_tracks(v as u32, MIN_TRACK_LENGTH) < need[v] {
-                done.images_short += short as usize;
-                short = false;
-                let best = incident[v]
-                    .iter()
-                    .copied()
-                    .filter(|&e| !kept[e])
-                    .map(|e| (tracks.gain(scene, e), e))
-                    .max();
-                // The selectable pairs give v twice its need, so they cannot run out first.
-                let Some((_, e)) = best else { break };
-                add(&mut tracks, kept, e);
-                done.pairs_added_for_images += 1;
+            in_forest[e] = true;
+            if !kept[e] {
+                keep(scene, tracks, kept, e);
+                added += 1;
             }
         }
     }
+    added
+}
 
-    let target = needs.min_track_length_ratio * done.track_length_full;
+/// Need 2: adds, image by image, the selectable pair that joins the most tracks until the image
+/// has `need` keypoints on long tracks; returns the images that were short and the pairs added.
+fn add_for_images(
+    scene: &Scene,
+    selectable: &[bool],
+    kept: &mut [bool],
+    tracks: &mut TrackSet,
+    need: &[usize],
+) -> (usize, usize) {
+    let vertices = scene.graph.num_vertices();
+    let (mut images_short, mut added) = (0, 0);
+    let mut incident = vec![Vec::new(); vertices];
+    for (k, e) in scene.graph.edges.iter().enumerate() {
+        if selectable[k] {
+            incident[e.i as usize].push(k);
+            incident[e.j as usize].push(k);
+        }
+    }
+    for v in 0..vertices {
+        let mut short = true;
+        while tracks.observations_on_tracks(v as u32, MIN_TRACK_LENGTH) < need[v] {
+            images_short += short as usize;
+            short = false;
+            let best = incident[v]
+                .iter()
+                .copied()
+                .filter(|&e| !kept[e])
+                .map(|e| (tracks.gain(scene, e), e))
+                .max();
+            // The selectable pairs give v twice its need, so they cannot run out first.
+            let Some((_, e)) = best else { break };
+            keep(scene, tracks, kept, e);
+            added += 1;
+        }
+    }
+    (images_short, added)
+}
+
+/// Need 3: adds the selectable pair that joins the most tracks (a lazy max-heap) until the mean
+/// track length reaches `target`; returns how many it added.
+fn add_for_track_length(
+    scene: &Scene,
+    selectable: &[bool],
+    kept: &mut [bool],
+    tracks: &mut TrackSet,
+    target: f64,
+) -> usize {
+    let mut added = 0;
     if tracks.mean_length() < target {
-        let mut heap: BinaryHeap<(usize, usize)> = (0..edges)
+        let mut heap: BinaryHeap<(usize, usize)> = (0..scene.graph.edges.len())
             .filter(|&e| selectable[e] && !kept[e])
             .map(|e| (tracks.gain(scene, e), e))
             .collect();
@@ -307,12 +358,11 @@ pub fn complete(
                 heap.push((now, e));
                 continue;
             }
-            add(&mut tracks, kept, e);
-            done.pairs_added_for_track_length += 1;
+            keep(scene, tracks, kept, e);
+            added += 1;
         }
     }
-    done.track_length = tracks.mean_length();
-    done
+    added
 }
 
 #[cfg(test)]

@@ -2,7 +2,8 @@
 //! plus random extra keypoints, in random order.
 
 use crate::eval::synth::scene::ScenePoint;
-use crate::eval::synth::{GtImage, SceneSpec};
+use crate::eval::synth::spec::SceneSpec;
+use crate::eval::synth::truth::GtImage;
 use rand::seq::SliceRandom;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

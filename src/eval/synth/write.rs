@@ -4,7 +4,8 @@
 use crate::colmap::blob::{encode_f32, encode_f64, encode_mat3, encode_pairs};
 use crate::eval::synth::matching::PairRows;
 use crate::eval::synth::observe::ImageObservations;
-use crate::eval::synth::{GtCamera, GtImage, SceneSpec};
+use crate::eval::synth::spec::SceneSpec;
+use crate::eval::synth::truth::{GtCamera, GtImage};
 use anyhow::{Context, Result};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

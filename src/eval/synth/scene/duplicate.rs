@@ -6,7 +6,8 @@
 //! copies into one ghosted model. The overview cameras truly link the groups.
 
 use crate::eval::synth::scene::{default_surfaces, look_at, sample_surface, ScenePoint, Surface};
-use crate::eval::synth::{GtImage, SceneSpec};
+use crate::eval::synth::spec::SceneSpec;
+use crate::eval::synth::truth::GtImage;
 use nalgebra::{Rotation3, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -34,6 +35,20 @@ pub(crate) fn build(
         Rotation3::identity(),
         Rotation3::from_axis_angle(&Vector3::z_axis(), yaw_degrees.to_radians()),
     ];
+    let points = points(spec, &centres, &turns, rng);
+    let images = cameras(spec, &centres, overview, rng);
+    (points, images)
+}
+
+/// The object sampled once and placed at each of `centres` turned by its `turns` (same
+/// appearance ids, copy 0 and 1), then a ground disc of its own under each copy.
+fn points(
+    spec: &SceneSpec,
+    centres: &[Vector3<f64>; 2],
+    turns: &[Rotation3<f64>; 2],
+    rng: &mut ChaCha8Rng,
+) -> Vec<ScenePoint> {
+    let r = spec.orbit_radius;
     let boxes: Vec<(Surface, f64)> = default_surfaces(spec)
         .into_iter()
         .filter(|(s, _)| matches!(s, Surface::Box { .. }))
@@ -46,7 +61,7 @@ pub(crate) fn build(
         object.extend(sample_surface(surface, n, rng));
     }
     let mut points = Vec::new();
-    for (copy, (centre, turn)) in centres.iter().zip(&turns).enumerate() {
+    for (copy, (centre, turn)) in centres.iter().zip(turns).enumerate() {
         for (k, (p, n)) in object.iter().enumerate() {
             points.push(ScenePoint {
                 position: centre + turn * p,
@@ -58,7 +73,7 @@ pub(crate) fn build(
     }
     let num_ground = (spec.num_points - object.len()) / 2;
     let ground = Surface::Ground { radius: 0.7 * r };
-    for centre in &centres {
+    for centre in centres {
         for (p, n) in sample_surface(&ground, num_ground, rng) {
             let appearance = (object.len() + points.len()) as u32;
             points.push(ScenePoint {
@@ -69,7 +84,18 @@ pub(crate) fn build(
             });
         }
     }
+    points
+}
 
+/// The cameras: one group orbiting each of `centres`, then `overview` looking at both; every
+/// eye and target jittered by the spec's pose jitter.
+fn cameras(
+    spec: &SceneSpec,
+    centres: &[Vector3<f64>; 2],
+    overview: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<GtImage> {
+    let r = spec.orbit_radius;
     let jitter = Normal::new(0.0, spec.pose_jitter.max(1e-12)).unwrap();
     let noisy = |v: Vector3<f64>, rng: &mut ChaCha8Rng| {
         v + Vector3::new(jitter.sample(rng), jitter.sample(rng), jitter.sample(rng))
@@ -96,7 +122,7 @@ pub(crate) fn build(
         let eye = Vector3::new(x, side * 2.4 * r, 1.5 * r);
         placements.push((eye, Vector3::new(0.0, 0.0, 0.5)));
     }
-    let images = placements
+    placements
         .into_iter()
         .enumerate()
         .map(|(i, (eye, target))| {
@@ -110,6 +136,5 @@ pub(crate) fn build(
                 centre,
             }
         })
-        .collect();
-    (points, images)
+        .collect()
 }

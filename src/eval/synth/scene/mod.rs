@@ -4,7 +4,7 @@
 pub mod duplicate;
 pub mod orbit;
 
-use crate::eval::synth::SceneSpec;
+use crate::eval::synth::spec::SceneSpec;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

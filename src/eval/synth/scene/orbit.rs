@@ -1,7 +1,8 @@
 //! The default scene: boxes on a ground disc, cameras on an orbit around them.
 
 use crate::eval::synth::scene::{default_surfaces, look_at, sample_surface, ScenePoint};
-use crate::eval::synth::{GtImage, SceneSpec};
+use crate::eval::synth::spec::SceneSpec;
+use crate::eval::synth::truth::GtImage;
 use nalgebra::Vector3;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
