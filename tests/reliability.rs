@@ -341,6 +341,30 @@ fn database_locked_by_another_writer() {
     assert_eq!(out.status.code(), Some(2));
 }
 
+/// `export --lock_timeout` is honoured: behind another process's exclusive lock (which readers
+/// wait for too) it gives up after the time given, not after the default 5 s it once used
+/// whatever the option said.
+#[test]
+fn export_waits_as_long_as_lock_timeout_says() {
+    let (dir, db) = scene();
+    let holder = LockHolder::new(&db, "BEGIN EXCLUSIVE");
+    let graph = dir.path().join("graph.dot");
+    let started = Instant::now();
+    let args = ["export", "--database_path", s(&db), "--format", "dot"];
+    let line = refused(
+        dir.path(),
+        &[&args[..], &["--output", s(&graph), "--lock_timeout", "0.5"]].concat(),
+    );
+    let waited = started.elapsed();
+    holder.release();
+    assert_has(&line, "database is locked by another process");
+    assert!(
+        waited >= Duration::from_millis(500),
+        "gave up after {waited:?}"
+    );
+    assert!(waited < Duration::from_secs(3), "waited {waited:?}");
+}
+
 /// vgsel-colmap under a file-size limit just above the database's size (so SQLite's write fails
 /// mid-transaction, as on a full disk), with SIGXFSZ ignored so the write returns EFBIG.
 fn prune_with_file_size_limit(limit: u64, args: &[&str]) -> Output {

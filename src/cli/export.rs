@@ -6,7 +6,6 @@ use crate::cli::progress::Progress;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::outputs::export;
 use vgsel_colmap::selection::pipeline;
 
@@ -23,7 +22,7 @@ pub struct ExportArgs {
 }
 
 pub fn run(args: &ExportArgs, quiet: bool, progress: &Progress) -> Result<()> {
-    let db = Database::open_read_only(&args.database.database_path)?;
+    let db = args.database.open(true)?;
     let stage = |s: &str| progress.stage(s);
     let plan = pipeline::last_plan(&db, &stage)?;
     let removed = db.invalidated_pair_ids()?;
