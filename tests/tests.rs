@@ -19,6 +19,7 @@ mod keep_neighbours;
 mod mapper;
 mod migration;
 mod pair_truth;
+mod presets;
 mod reliability;
 mod rewrite;
 mod search;
