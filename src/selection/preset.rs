@@ -39,11 +39,13 @@ impl Named for Preset {
         }
     }
 
+    // What each preset is for, in words: its numbers are the table's (`defaults`), which
+    // `prune --help` shows beside each option.
     fn help(self) -> &'static str {
         match self {
-            Preset::General => "Image priors degree, track fraction, clustering; pair priors inliers, triangulation angle, overlap, infinite homography. Search: 90% of images; then the track completion adds pairs until every image keeps 100 keypoints on tracks of three or more images (half of its own, if fewer) and the tracks keep 0.7 of the full graph's mean length: as many pairs as the images need to stay registrable and accurate, which adapts to how densely they overlap",
-            Preset::Disambiguation => "For scenes with duplicate or symmetric structure, whatever the image order: pair prior backbone tracks (the share of a pair's inliers that tracks through each image's strongest pairs join), pairs below fitness 0.6 never selected (lowered as far as the search needs); the paper's context, loop and multiple motions, loop fraction and unique tracks at weight 0 (in --scores). Search: 80% of images, 5 pairs per image",
-            Preset::PaperDisambiguation => "The paper's section 5.1 as written, for its lab scenes: context similarity, loop consistency and multiple motions with uniform weights, no fitness floor; search: 25% of the view graph's pairs (its lab criterion), no image criterion. Relies on the pair arcs following the capture order (--order)",
+            Preset::General => "Speed on ordinary scenes: image priors degree, track fraction, clustering; pair priors inliers, triangulation angle, overlap, infinite homography; the search keeps most images, then the track completion adds the pairs the images need to stay registrable and accurate",
+            Preset::Disambiguation => "Scenes with duplicate or symmetric structure, whatever the image order: pair prior backbone tracks (the share of a pair's inliers that tracks through each image's strongest pairs join), pairs below a fitness floor never selected; the paper's context, loop and multiple motions, loop fraction and unique tracks at weight 0 (in --scores)",
+            Preset::PaperDisambiguation => "The paper's section 5.1 as written, for comparison: context similarity, loop consistency and multiple motions with uniform weights, no fitness floor, the paper's share of pairs; relies on the pair arcs following the capture order (--order)",
         }
     }
 }
