@@ -80,6 +80,36 @@ pub fn preset_defaults(command: clap::Command) -> clap::Command {
         .mut_subcommand("solve", |c| with_defaults(c, &[Preset::General]))
 }
 
+/// Reads one default out of a preset's row.
+type Field = fn(&Defaults) -> String;
+
+/// Each option whose default the preset decides, and where the table holds it.
+const PRESET_DEFAULTS: [(&str, Field); 9] = [
+    ("min_image_fraction", |d| {
+        d.criteria.min_image_fraction.to_string()
+    }),
+    ("min_pairs_per_image", |d| {
+        d.criteria.min_pairs_per_image.to_string()
+    }),
+    ("min_pair_fraction", |d| {
+        d.criteria.min_pair_fraction.to_string()
+    }),
+    ("min_pairs_each", |d| d.criteria.min_pairs_each.to_string()),
+    ("min_track_observations", |d| {
+        d.completion.min_track_observations.to_string()
+    }),
+    ("min_track_length_ratio", |d| {
+        d.completion.min_track_length_ratio.to_string()
+    }),
+    ("spanning_forests", |d| {
+        d.completion.spanning_forests.to_string()
+    }),
+    ("biconnected", |d| d.biconnected.to_string()),
+    ("min_pair_fitness", |d| {
+        d.cost_model.min_pair_fitness.to_string()
+    }),
+];
+
 fn with_defaults(command: clap::Command, presets: &[Preset]) -> clap::Command {
     let rows: Vec<(Preset, Defaults)> = presets.iter().map(|&p| (p, p.defaults())).collect();
     let per = |value: &dyn Fn(&Defaults) -> String| {
@@ -93,41 +123,7 @@ fn with_defaults(command: clap::Command, presets: &[Preset]) -> clap::Command {
             .collect();
         each.join(", ")
     };
-    let defaults = [
-        (
-            "min_image_fraction",
-            per(&|d| d.criteria.min_image_fraction.to_string()),
-        ),
-        (
-            "min_pairs_per_image",
-            per(&|d| d.criteria.min_pairs_per_image.to_string()),
-        ),
-        (
-            "min_pair_fraction",
-            per(&|d| d.criteria.min_pair_fraction.to_string()),
-        ),
-        (
-            "min_pairs_each",
-            per(&|d| d.criteria.min_pairs_each.to_string()),
-        ),
-        (
-            "min_track_observations",
-            per(&|d| d.completion.min_track_observations.to_string()),
-        ),
-        (
-            "min_track_length_ratio",
-            per(&|d| d.completion.min_track_length_ratio.to_string()),
-        ),
-        (
-            "spanning_forests",
-            per(&|d| d.completion.spanning_forests.to_string()),
-        ),
-        ("biconnected", per(&|d| d.biconnected.to_string())),
-        (
-            "min_pair_fitness",
-            per(&|d| d.cost_model.min_pair_fitness.to_string()),
-        ),
-    ];
+    let defaults = PRESET_DEFAULTS.iter().map(|&(id, value)| (id, per(&value)));
     let ids: Vec<String> = command
         .get_arguments()
         .map(|a| a.get_id().to_string())
