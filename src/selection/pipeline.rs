@@ -82,7 +82,7 @@ pub struct Plan {
     pub search: SearchResult,
     /// What the track completion added to the flow's selection (None when it did not run).
     pub completion: Option<Completion>,
-    /// The fitness floor applied (see [`fitness_floor`]).
+    /// The fitness floor applied (see [`arc_rules::fitness_floor`]).
     pub fitness_floor: f64,
     /// Free edges (neither kept nor forbidden) below `fitness_floor`, taken out of the network.
     pub below_fitness_floor: usize,
