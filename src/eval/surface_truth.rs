@@ -76,7 +76,7 @@ mod tests {
     fn true_matches_transfer_exactly_and_copies_do_not() {
         let scene = Scene::build(SceneKind::Street, 20, 1).unwrap();
         let (a, b) = (model_image(&scene, 8), model_image(&scene, 10));
-        let point = Vector3::new(9.5, 0.0, 1.7);
+        let point = Vector3::new(11.5, 0.0, 1.7);
         let x1 = project(&a, &point);
         assert!(transfer_error(&scene, &a, &b, &x1, &project(&b, &point), 400.0) < 1e-6);
         let copy = point + Vector3::new(STREET_PERIOD, 0.0, 0.0);
@@ -84,9 +84,9 @@ mod tests {
         assert!(e > 100.0 && e.is_finite(), "{e}");
         let sky = [0.0, -1.0];
         assert!(transfer_error(&scene, &a, &b, &sky, &sky, 400.0).is_infinite());
-        // The far wall through the gap after building 2, seen from camera 8 (x 9.7): from
-        // camera 10 (x 12.1) building 3 stands in the way.
-        let gap = Vector3::new(14.0, 12.0, 1.0);
+        // The far wall through the gap after building 2, seen from camera 8 (x 12.2): from
+        // camera 10 (x 15.3) building 3 stands in the way.
+        let gap = Vector3::new(15.2, 9.0, 1.0);
         let x = project(&a, &gap);
         let through = a.rotation.inverse() * Vector3::new(x[0], x[1], 1.0);
         let seen = scene.surface_point(&a.centre(), &through).unwrap();
