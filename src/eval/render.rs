@@ -10,9 +10,9 @@
 //! Images are ray cast with 2x2 supersampling through one SIMPLE_RADIAL camera with k = 0
 //! (COLMAP's pixel convention: the centre of pixel (i, j) is at (i + 0.5, j + 0.5)); the ground
 //! truth is written as a COLMAP text model. Everything is deterministic from the seed, and the
-//! ground-truth folder also gets `scene.json` ([`SceneRecord`]: design, images, seed), from which
-//! [`Scene::load`] rebuilds the scene's surfaces: the exact pair labels cast rays into them
-//! (`eval::surface_truth`).
+//! ground-truth folder also gets `scene.json` ([`SceneRecord`]: design, images, seed; and a
+//! fingerprint of the surfaces), from which [`Scene::load`] rebuilds the scene's surfaces: the
+//! exact pair labels cast rays into them (`eval::surface_truth`).
 
 use crate::colmap::ids::SIMPLE_RADIAL;
 use crate::eval::synth::scene::look_at;
@@ -78,6 +78,16 @@ pub struct SceneRecord {
 
 /// The file name of the [`SceneRecord`] in a ground-truth folder.
 pub const SCENE_RECORD: &str = "scene.json";
+
+/// What `scene.json` holds: the record, and a fingerprint of the surfaces it built (so that a
+/// renderer whose geometry changed since is noticed even where its cameras did not move).
+#[derive(Serialize, Deserialize)]
+struct RecordFile {
+    #[serde(flatten)]
+    record: SceneRecord,
+    /// [`Scene::surfaces_fingerprint`] in hex.
+    surfaces: String,
+}
 
 /// An axis-aligned box; `inside` boxes (the room) are seen from within.
 #[derive(Clone, Debug)]
@@ -482,9 +492,16 @@ impl Scene {
         }
         let text = std::fs::read_to_string(&path)
             .with_context(|| format!("reading {}", path.display()))?;
-        let record: SceneRecord =
+        let file: RecordFile =
             serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+        let record = file.record;
         let scene = Scene::build(record.kind, record.num_images, record.seed)?;
+        ensure!(
+            file.surfaces == format!("{:016x}", scene.surfaces_fingerprint()),
+            "{}: the surfaces rebuilt from it are not the ones rendered: the renderer changed \
+             since, render again",
+            path.display()
+        );
         let written = crate::colmap::model::read_images(gt)?;
         for im in &written {
             let rebuilt = scene.truth.images.iter().find(|r| r.name == im.name);
@@ -497,6 +514,19 @@ impl Scene {
             );
         }
         Ok(Some(scene))
+    }
+
+    /// A hash of every box's corners, texture seeds and kind: what the labels' rays meet.
+    fn surfaces_fingerprint(&self) -> u64 {
+        let mut h = 0;
+        for c in &self.cuboids {
+            let corners = c.min.iter().chain(c.max.iter()).map(|v| v.to_bits());
+            let flags = [c.inside as u64, c.half_turn as u64];
+            for v in corners.chain(c.faces).chain(c.east).chain(flags) {
+                h = hash(h ^ v);
+            }
+        }
+        h
     }
 
     /// The first surface point along the ray from `origin` in direction `dir` (any length), if
@@ -604,7 +634,11 @@ impl Scene {
     pub fn write_truth(&self, gt: &Path) -> Result<()> {
         write_gt_model(&self.truth, gt)?;
         let path = gt.join(SCENE_RECORD);
-        std::fs::write(&path, serde_json::to_string_pretty(&self.record)? + "\n")
+        let file = RecordFile {
+            record: self.record,
+            surfaces: format!("{:016x}", self.surfaces_fingerprint()),
+        };
+        std::fs::write(&path, serde_json::to_string_pretty(&file)? + "\n")
             .with_context(|| format!("writing {}", path.display()))
     }
 }
@@ -720,9 +754,9 @@ mod tests {
         assert!(xs[19] - xs[0] > 3.0 * STREET_PERIOD);
     }
 
-    /// The ground truth's scene.json rebuilds the scene, and a ground truth whose cameras are
-    /// not the rebuilt ones (a renderer changed since) is refused; without scene.json there is
-    /// no scene.
+    /// The ground truth's scene.json rebuilds the scene, and a ground truth whose cameras or
+    /// surfaces are not the rebuilt ones (a renderer changed since) is refused; without
+    /// scene.json there is no scene.
     #[test]
     fn scene_record_rebuilds_the_scene_and_refuses_other_cameras() {
         let dir = tempfile::tempdir().unwrap();
@@ -734,10 +768,26 @@ mod tests {
         let scene = Scene::load(&gt).unwrap().expect("scene.json written");
         assert_eq!(scene.record.kind, SceneKind::Twin);
         assert_eq!((scene.record.num_images, scene.record.seed), (8, 3));
+        let record = std::fs::read_to_string(gt.join(SCENE_RECORD)).unwrap();
+        let moved = serde_json::from_str::<serde_json::Value>(&record).unwrap()["surfaces"]
+            .as_str()
+            .unwrap()
+            .to_string();
+        let changed = record.replace(&moved, "0123456789abcdef");
+        std::fs::write(gt.join(SCENE_RECORD), changed).unwrap();
+        let err = Scene::load(&gt).unwrap_err().to_string();
+        assert!(
+            err.contains("surfaces") && err.contains("render again"),
+            "{err}"
+        );
+        std::fs::write(gt.join(SCENE_RECORD), record).unwrap();
         let other = Scene::build(SceneKind::Twin, 8, 4).unwrap();
         write_gt_model(&other.truth, &gt).unwrap();
         let err = Scene::load(&gt).unwrap_err().to_string();
-        assert!(err.contains("render again"), "{err}");
+        assert!(
+            err.contains("is not where") && err.contains("render again"),
+            "{err}"
+        );
         std::fs::remove_file(gt.join(SCENE_RECORD)).unwrap();
         assert!(Scene::load(&gt).unwrap().is_none());
     }
