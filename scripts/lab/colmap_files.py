@@ -1,6 +1,7 @@
 """What the measuring scripts read from COLMAP's files, in one place: a database's view graph
 (through the binary, never by SQL of their own), image names in capture order, and text models
-(camera centres, the 3D points each image sees, the points' positions).
+(camera centres, the 3D points each image sees, the points' positions); and the one way they
+make a database: a copy in which exactly chosen pairs stay valid (through `prune`).
 Standard library only, so that the system python runs it.
 """
 import contextlib
@@ -41,6 +42,25 @@ def view_graph(db):
     pairs = [tuple(sorted((ids[e.get("source")], ids[e.get("target")])))
              for e in root.iterfind("g:graph/g:edge", ns)]
     return {i: name for name, i in ids.items()}, pairs
+
+
+def only_pairs(db, out, keep, work, tag):
+    """A copy `out` of db in which, of the view graph's pairs, exactly those for which
+    `keep(rank, a, b)` holds stay valid (rank: image_id -> position in name order): `prune` keeps
+    them (`--keep_pairs`) and forbids every other (`--forbid_pairs`), so its flow and track
+    completion can add none. Pairs below the mapper's 15 inliers are left as they are. The lists
+    are written to work/keep_TAG.txt and work/forbid_TAG.txt."""
+    names, pairs = view_graph(db)
+    rank = name_ranks(names)
+    lists = {"keep": [p for p in pairs if keep(rank, *p)],
+             "forbid": [p for p in pairs if not keep(rank, *p)]}
+    for kind, chosen in lists.items():
+        with open(os.path.join(work, f"{kind}_{tag}.txt"), "w") as f:
+            f.writelines(f"{names[a]} {names[b]}\n" for a, b in chosen)
+    subprocess.run(["nice", "-n", "5", VGSEL, "prune", "-q", "--database_path", db, "--output",
+                    out, "--overwrite", "--keep_pairs", os.path.join(work, f"keep_{tag}.txt"),
+                    "--forbid_pairs", os.path.join(work, f"forbid_{tag}.txt")],
+                   check=True, capture_output=True)
 
 
 def camera_centre(qw, qx, qy, qz, tx, ty, tz):

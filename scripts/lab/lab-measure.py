@@ -56,7 +56,7 @@ import shutil
 import subprocess
 import sys
 
-from colmap_files import ROOT, VGSEL, name_ranks, natural, read_images, view_graph
+from colmap_files import ROOT, VGSEL, natural, only_pairs, read_images, view_graph
 
 WINDOW = 3
 
@@ -112,23 +112,6 @@ def global_mapper(db, images, out):
          copy, images, out], out + ".log")
     os.remove(copy)
     open(out + ".done", "w").close()
-
-
-def only_pairs(db, out, keep, work, tag):
-    """A copy `out` of db in which, of the view graph's pairs, exactly those for which
-    `keep(rank, a, b)` holds stay valid (rank: image_id -> position in name order): `prune` keeps
-    them (`--keep_pairs`) and forbids every other (`--forbid_pairs`), so its flow and track
-    completion can add none. Pairs below the mapper's 15 inliers are left as they are."""
-    names, pairs = view_graph(db)
-    rank = name_ranks(names)
-    lists = {"keep": [p for p in pairs if keep(rank, *p)],
-             "forbid": [p for p in pairs if not keep(rank, *p)]}
-    for kind, chosen in lists.items():
-        with open(os.path.join(work, f"{kind}_{tag}.txt"), "w") as f:
-            f.writelines(f"{names[a]} {names[b]}\n" for a, b in chosen)
-    run([VGSEL, "prune", "-q", "--database_path", db, "--output", out, "--overwrite",
-         "--keep_pairs", os.path.join(work, f"keep_{tag}.txt"),
-         "--forbid_pairs", os.path.join(work, f"forbid_{tag}.txt")])
 
 
 def sequential_copy(db, out, work):

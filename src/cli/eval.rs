@@ -18,13 +18,14 @@ pub struct EvalArgs {
     #[arg(long, value_name = "DIR")]
     ground_truth: Option<PathBuf>,
     /// The database the model was made from: reports the pairs the mapper used and, with a
-    /// (text) ground truth, labels them true or false by their epipolar error.
+    /// (text) ground truth, labels them true or false: exactly for a rendered scene (its
+    /// scene.json: the surface behind each inlier), by the epipolar error otherwise.
     #[arg(long, value_name = "DB")]
     database_path: Option<PathBuf>,
     /// The database before the prune: adds false pairs removed and true pairs kept.
     #[arg(long, value_name = "ORIGINAL.db", requires = "database_path")]
     baseline: Option<PathBuf>,
-    /// Write every verified pair's ground-truth label (median Sampson error in px, true/false)
+    /// Write every verified pair's ground-truth label (median error in px, true/false)
     /// as CSV, keyed by image ids like `prune --scores`, to measure priors against the truth.
     #[arg(long, value_name = "FILE", requires_all = ["database_path", "ground_truth"])]
     labels: Option<PathBuf>,

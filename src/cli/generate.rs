@@ -13,7 +13,8 @@ pub enum GenerateCommand {
     Database(GenerateDatabaseArgs),
     /// A synthetic view graph of the paper's supplement in the `solve` text format.
     Graph(GenerateGraphArgs),
-    /// Rendered PNG images of a textured scene (DIR/images) with ground-truth poses (DIR/gt).
+    /// Rendered PNG images of a textured scene (DIR/images) with ground-truth poses (DIR/gt, and
+    /// DIR/gt/scene.json, from which `eval --labels` rebuilds the surfaces).
     Images(GenerateImagesArgs),
 }
 
@@ -50,6 +51,8 @@ enum SceneArg {
     Twin,
     /// One object that looks the same from opposite sides, orbited all round.
     Symmetric,
+    /// A row of identical buildings walked past by cameras translating along it.
+    Street,
 }
 
 #[derive(Args)]
@@ -102,6 +105,7 @@ pub fn run(command: &GenerateCommand) -> Result<()> {
                 SceneArg::Duplicate => render::SceneKind::Duplicate,
                 SceneArg::Twin => render::SceneKind::Twin,
                 SceneArg::Symmetric => render::SceneKind::Symmetric,
+                SceneArg::Street => render::SceneKind::Street,
             };
             render::Scene::build(kind, args.num_images, args.seed)
                 .and_then(|scene| scene.write(&args.output))

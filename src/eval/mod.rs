@@ -6,4 +6,5 @@ pub mod pair_truth;
 pub mod render;
 pub mod score;
 pub mod separation;
+pub mod surface_truth;
 pub mod synth;

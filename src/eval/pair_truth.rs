@@ -1,4 +1,7 @@
-//! Labelling a database's verified pairs true or false from ground-truth poses: a pair is true
+//! Labelling a database's verified pairs true or false from ground truth. For a scene rendered
+//! here (its ground truth has the renderer's `scene.json`) the labels are exact: each inlier is
+//! checked against the surface behind it ([`surface_truth`](crate::eval::surface_truth)). For
+//! any other ground truth they come from the poses alone: a pair is true
 //! when the median Sampson distance of its inliers under the ground-truth epipolar geometry is
 //! below a few pixels, where an inlier whose rays meet behind a camera or beyond the scene counts
 //! as infinitely far off. A false pair (matches between two copies of a duplicated object) is
@@ -16,6 +19,8 @@ use crate::colmap::ids::image_ids;
 use crate::colmap::ids::{camera_model_id, camera_model_num_params};
 use crate::colmap::model;
 use crate::eval::align::scene_extent;
+use crate::eval::render::Scene;
+use crate::eval::surface_truth::{transfer_error, TRANSFER_THRESHOLD_PX};
 use crate::geometry::camera::CameraModel;
 use crate::geometry::pose::{sampson_distance, triangulate};
 use anyhow::{ensure, Context, Result};
@@ -90,7 +95,9 @@ pub struct PairCounts {
 /// when a baseline is given.
 #[derive(Clone, Debug, Serialize)]
 pub struct PairReport {
-    /// The Sampson threshold the labels used ([`SAMPSON_THRESHOLD_PX`]).
+    /// Which judge labelled the pairs: `surface` (the rendered scene's geometry) or `epipolar`.
+    pub labels: &'static str,
+    /// The threshold the labels used ([`TRANSFER_THRESHOLD_PX`] or [`SAMPSON_THRESHOLD_PX`]).
     pub threshold_px: f64,
     /// Labels of the pairs the database lets the mapper use.
     #[serde(flatten)]
@@ -106,16 +113,114 @@ pub struct PairReport {
     pub true_kept: Option<usize>,
 }
 
-/// Median Sampson error in pixels of each of the database's verified pairs (as originally
-/// verified) under the ground truth, or None when an image is not in it; keyed by pair_id.
-fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
+/// How a pair's inliers are judged: against the surfaces of the rendered scene the ground truth
+/// was written with (exact, [`surface_truth`]), or, for any other ground truth (photographs, the
+/// synthetic databases), by the epipolar geometry with rays that must meet in the scene.
+pub enum Judge {
+    /// The renderer's geometry, rebuilt from the ground truth's `scene.json`.
+    Surface(Box<Scene>),
+    /// The Sampson distance; rays must meet in front of both cameras nearer than `max_depth`.
+    Epipolar {
+        /// [`MAX_DEPTH_EXTENTS`] times the extent of the ground truth's camera centres.
+        max_depth: f64,
+    },
+}
+
+impl Judge {
+    /// The judge for ground truth `gt` (whose images are `truth`).
+    pub fn for_truth(gt: &Path, truth: &[model::ModelImage]) -> Result<Judge> {
+        Ok(match Scene::load(gt)? {
+            Some(scene) => Judge::Surface(Box::new(scene)),
+            None => {
+                let centres: Vec<_> = truth.iter().map(model::ModelImage::centre).collect();
+                Judge::Epipolar {
+                    max_depth: MAX_DEPTH_EXTENTS * scene_extent(&centres),
+                }
+            }
+        })
+    }
+
+    /// A pair is true when its median error is below this many pixels.
+    pub fn threshold_px(&self) -> f64 {
+        match self {
+            Judge::Surface(_) => TRANSFER_THRESHOLD_PX,
+            Judge::Epipolar { .. } => SAMPSON_THRESHOLD_PX,
+        }
+    }
+
+    /// `surface` or `epipolar`, as the report names the labels.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Judge::Surface(_) => "surface",
+            Judge::Epipolar { .. } => "epipolar",
+        }
+    }
+
+    /// The labels CSV's error column.
+    fn column(&self) -> &'static str {
+        match self {
+            Judge::Surface(_) => "median_transfer_px",
+            Judge::Epipolar { .. } => "median_sampson_px",
+        }
+    }
+
+    /// The error in pixels (at `focal`) of each inlier `[a, b]` between keypoints `x[0][a]` of
+    /// `poses[0]` and `x[1][b]` of `poses[1]` (undistorted normalised coordinates).
+    fn inlier_errors(
+        &self,
+        poses: [&model::ModelImage; 2],
+        x: [&[[f64; 2]]; 2],
+        inliers: &[[u32; 2]],
+        focal: f64,
+    ) -> Vec<f64> {
+        let pair = |&[a, b]: &[u32; 2]| (x[0][a as usize], x[1][b as usize]);
+        match self {
+            Judge::Surface(scene) => inliers
+                .iter()
+                .map(|i| {
+                    let (x1, x2) = pair(i);
+                    transfer_error(scene, poses[0], poses[1], &x1, &x2, focal)
+                })
+                .collect(),
+            Judge::Epipolar { max_depth } => {
+                let r1 = poses[0].rotation.to_rotation_matrix();
+                let r = poses[1].rotation.to_rotation_matrix() * r1.inverse();
+                let t = poses[1].translation - r * poses[0].translation;
+                let e = t.cross_matrix() * r.matrix();
+                inliers
+                    .iter()
+                    .map(|i| {
+                        let (x1, x2) = pair(i);
+                        if meets_in_scene(&r, &t, &x1, &x2, *max_depth) {
+                            focal * sampson_distance(&e, &x1, &x2)
+                        } else {
+                            f64::INFINITY
+                        }
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+/// The median of `errors` (infinite when empty).
+fn median(mut errors: Vec<f64>) -> f64 {
+    errors.sort_by(f64::total_cmp);
+    errors
+        .get(errors.len() / 2)
+        .copied()
+        .unwrap_or(f64::INFINITY)
+}
+
+/// The judge of ground truth `gt`, and the median error in pixels of each of the database's
+/// verified pairs (as originally verified) under it, or None when an image is not in the
+/// ground truth; keyed by pair_id.
+fn pair_errors(db: &Database, gt: &Path) -> Result<(Judge, HashMap<u64, Option<f64>>)> {
     let cameras = read_cameras(gt)?;
-    let truth: HashMap<String, model::ModelImage> = model::read_images(gt)?
-        .into_iter()
-        .map(|im| (im.name.clone(), im))
-        .collect();
-    let centres: Vec<_> = truth.values().map(model::ModelImage::centre).collect();
-    let max_depth = MAX_DEPTH_EXTENTS * scene_extent(&centres);
+    let images = model::read_images(gt)?;
+    let judge = Judge::for_truth(gt, &images)?;
+    let truth: HashMap<String, model::ModelImage> =
+        images.into_iter().map(|im| (im.name.clone(), im)).collect();
     let names: HashMap<u32, String> = db
         .images()?
         .into_iter()
@@ -126,49 +231,25 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<f64>>> {
     for pair in db.verified_pairs()? {
         let ids = [pair.image_id1, pair.image_id2];
         let pid = crate::colmap::ids::pair_id(ids[0], ids[1]);
-        let poses: Option<Vec<&model::ModelImage>> =
-            ids.iter().map(|id| truth.get(&names[id])).collect();
-        let Some(poses) = poses else {
+        let (Some(p1), Some(p2)) = (truth.get(&names[&ids[0]]), truth.get(&names[&ids[1]])) else {
             labels.insert(pid, None);
             continue;
         };
-        let mut intr = Vec::new();
-        for (pose, id) in poses.iter().zip(ids) {
+        let mut focal = 0.0;
+        for (pose, id) in [(p1, ids[0]), (p2, ids[1])] {
             let camera = cameras
                 .get(&pose.camera_id)
                 .with_context(|| format!("{}: image {} has no camera", gt.display(), pose.name))?;
             if let std::collections::hash_map::Entry::Vacant(v) = keypoints.entry(id) {
                 v.insert(camera.normalise(&db.keypoints_xy(id)?)?);
             }
-            intr.push(camera);
+            focal += (camera.fx + camera.fy) / 4.0;
         }
-        let r1 = poses[0].rotation.to_rotation_matrix();
-        let r2 = poses[1].rotation.to_rotation_matrix();
-        let r = r2 * r1.inverse();
-        let t = poses[1].translation - r * poses[0].translation;
-        let e = t.cross_matrix() * r.matrix();
-        let focal = (intr[0].fx + intr[0].fy + intr[1].fx + intr[1].fy) / 4.0;
-        let mut errors: Vec<f64> = pair
-            .inliers
-            .iter()
-            .map(|&[a, b]| {
-                let x1 = keypoints[&ids[0]][a as usize];
-                let x2 = keypoints[&ids[1]][b as usize];
-                if meets_in_scene(&r, &t, &x1, &x2, max_depth) {
-                    focal * sampson_distance(&e, &x1, &x2)
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .collect();
-        errors.sort_by(f64::total_cmp);
-        let median = errors
-            .get(errors.len() / 2)
-            .copied()
-            .unwrap_or(f64::INFINITY);
-        labels.insert(pid, Some(median));
+        let x = [&keypoints[&ids[0]][..], &keypoints[&ids[1]][..]];
+        let errors = judge.inlier_errors([p1, p2], x, &pair.inliers, focal);
+        labels.insert(pid, Some(median(errors)));
     }
-    Ok(labels)
+    Ok((judge, labels))
 }
 
 /// Whether the rays of normalised points `x1`, `x2` (camera 2 = `r` · camera 1 + `t`) meet in
@@ -183,27 +264,34 @@ fn meets_in_scene(
     triangulate(r, t, x1, x2).is_some_and(|p| p.z < max_depth && (r * p + t).z < max_depth)
 }
 
-/// True (epipolar error below [`SAMPSON_THRESHOLD_PX`]), false, or None without ground truth.
-fn label_pairs(db: &Database, gt: &Path) -> Result<HashMap<u64, Option<bool>>> {
-    Ok(pair_errors(db, gt)?
+/// The judge, and each pair true (median error below the judge's threshold), false, or None
+/// without ground truth.
+fn label_pairs(db: &Database, gt: &Path) -> Result<(Judge, HashMap<u64, Option<bool>>)> {
+    let (judge, errors) = pair_errors(db, gt)?;
+    let threshold = judge.threshold_px();
+    let labels = errors
         .into_iter()
-        .map(|(pid, e)| (pid, e.map(|e| e < SAMPSON_THRESHOLD_PX)))
-        .collect())
+        .map(|(pid, e)| (pid, e.map(|e| e < threshold)))
+        .collect();
+    Ok((judge, labels))
 }
 
 /// `eval --labels`: a CSV row per verified pair with ground truth (image ids ascending as in
-/// `--scores`), its median Sampson error and its label, to join with a prune's `--scores`.
+/// `--scores`), its median error and its label, to join with a prune's `--scores`. The error
+/// column says which judge labelled: `median_transfer_px` (a rendered scene's surfaces) or
+/// `median_sampson_px` (epipolar).
 pub fn labels_csv(db_path: &Path, gt: &Path) -> Result<String> {
     let db = Database::open_read_only(db_path)?;
-    let mut rows: Vec<(u64, f64)> = pair_errors(&db, gt)?
+    let (judge, errors) = pair_errors(&db, gt)?;
+    let mut rows: Vec<(u64, f64)> = errors
         .into_iter()
         .filter_map(|(pid, e)| Some((pid, e?)))
         .collect();
     rows.sort_by_key(|r| r.0);
-    let mut out = String::from("image_id1,image_id2,median_sampson_px,true_pair\n");
+    let mut out = format!("image_id1,image_id2,{},true_pair\n", judge.column());
     for (pid, e) in rows {
         let (a, b) = image_ids(pid);
-        let label = (e < SAMPSON_THRESHOLD_PX) as u8;
+        let label = (e < judge.threshold_px()) as u8;
         out.push_str(&format!("{a},{b},{e:.3},{label}\n"));
     }
     Ok(out)
@@ -255,7 +343,7 @@ pub fn report(
     min_num_matches: usize,
 ) -> Result<PairReport> {
     let db = Database::open_read_only(db_path)?;
-    let labels = label_pairs(&db, gt)?;
+    let (judge, labels) = label_pairs(&db, gt)?;
     let gt_names: HashSet<String> = model::read_images(gt)?
         .into_iter()
         .map(|im| im.name)
@@ -269,7 +357,8 @@ pub fn report(
     let used = db.used_pair_ids(min_num_matches)?;
     let counts = count(&used, &labels, &gt_images);
     let mut out = PairReport {
-        threshold_px: SAMPSON_THRESHOLD_PX,
+        labels: judge.name(),
+        threshold_px: judge.threshold_px(),
         counts,
         baseline: None,
         false_removed: None,
