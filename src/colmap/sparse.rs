@@ -232,7 +232,10 @@ fn read_text_images(dir: &Path) -> Result<Vec<SparseImage>> {
 
 fn text_points2d(line: &str) -> Result<Vec<Point2D>> {
     let tok: Vec<&str> = line.split_whitespace().collect();
-    ensure!(tok.len() % 3 == 0, "expected X Y POINT3D_ID triples");
+    ensure!(
+        tok.len().is_multiple_of(3),
+        "expected X Y POINT3D_ID triples"
+    );
     tok.chunks(3)
         .map(|c| {
             let id: i64 = c[2].parse().context("bad POINT3D_ID")?;
