@@ -220,3 +220,6 @@ fn describe(
         joining_pairs: joining,
     }
 }
+
+#[cfg(test)]
+mod tests;
