@@ -164,4 +164,3 @@ fn projection_applies_radial_distortion() {
         .project(&Vector3::new(0.0, 0.0, -1.0))
         .is_none());
 }
-
