@@ -135,10 +135,13 @@ pub fn check_model(
     let covisibility = splits::Covisibility::new(&views);
     let tree = splits::spanning_tree(n, &covisibility);
     let candidates = splits::candidate_splits(n, &tree, settings.min_group);
+    // The worst split: the highest ratio among those with enough conflicts to be judged, else
+    // the highest ratio (reported, never ghosted).
+    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, c.ratio());
     let mut worst: Option<(Vec<bool>, Counts)> = None;
     for side in &candidates {
         let counts = conflict::count(&views, side, &settings.conflict);
-        if worst.as_ref().is_none_or(|w| counts.ratio() > w.1.ratio()) {
+        if worst.as_ref().is_none_or(|w| rank(&counts) > rank(&w.1)) {
             worst = Some((side.clone(), counts));
         }
     }
