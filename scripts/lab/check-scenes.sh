@@ -13,6 +13,7 @@
 #          sequences) is judged by scripts/lab/topview.py's capture-order check instead, on the
 #          largest model of the COLMAP 3.8 runs only (needs pycolmap's python for numpy)
 # environment: GLOBAL=1 adds COLMAP 4.2's global mapper; CHECK_ARGS extra `check` options;
+#   CHECK_ONLY=1 only checks (and scores) the models a previous run built;
 #   IMAGES_LIMIT=N uses the first N images (by name) of a dataset; VGSEL the binary.
 # Truth: a model is ghosted when at least 2 and at least 20% of its registered images are not
 # correct (eval: centre within 5% of the extent, rotation within 5 degrees); without ground
@@ -33,6 +34,7 @@ export VGSEL=$bin
 
 for scene in "${scenes[@]}"; do
   dir=$work/$scene
+  [ "${CHECK_ONLY:-0}" = 1 ] && continue
   case $scene in
     duplicate | twin | symmetric | room)
       # As tests/e2e.rs and docs/priors.md render them: the twin needs 36 images to map at all.

@@ -61,11 +61,9 @@ fn membership(views: &Views, side: &[bool]) -> Vec<[bool; 2]> {
 /// The conflicts of the split `side` (true: group B) in both directions.
 pub fn count(views: &Views, side: &[bool], settings: &ConflictSettings) -> Counts {
     let member = membership(views, side);
-    let cos_max = settings.max_angle_deg.to_radians().cos();
     let mut counts = Counts::default();
     for (k, track) in views.observers.iter().enumerate() {
-        let x = views.points[k];
-        for (b, view) in views.views.iter().enumerate() {
+        for b in 0..views.views.len() {
             let group = usize::from(side[b]);
             // Only points the other group saw.
             if !member[k][1 - group] {
@@ -75,28 +73,69 @@ pub fn count(views: &Views, side: &[bool], settings: &ConflictSettings) -> Count
                 counts.seen += 1;
                 continue;
             }
-            let ray = (x - view.centre).normalize();
-            let close = track
+            let from: Vec<usize> = track
                 .iter()
-                .filter(|&&a| usize::from(side[a]) != group)
-                .any(|&a| ray.dot(&(x - views.views[a].centre).normalize()) >= cos_max);
-            if !close {
+                .copied()
+                .filter(|&a| usize::from(side[a]) != group)
+                .collect();
+            let ours = |j: usize| member[j][1 - group];
+            match judge(views, k, b, &from, &ours, settings) {
+                Some(true) => counts.conflicting += 1,
+                Some(false) => counts.agreeing += 1,
+                None => {}
+            }
+        }
+    }
+    counts
+}
+
+/// How one sample ends: `None` when not judged (behind, outside, too oblique, nothing near).
+/// `ours(j)` says whether point `j` belongs to the projecting side.
+fn judge(
+    views: &Views,
+    k: usize,
+    b: usize,
+    from: &[usize],
+    ours: &dyn Fn(usize) -> bool,
+    settings: &ConflictSettings,
+) -> Option<bool> {
+    let x = views.points[k];
+    let view = &views.views[b];
+    let ray = (x - view.centre).normalize();
+    let cos_max = settings.max_angle_deg.to_radians().cos();
+    let close = from
+        .iter()
+        .any(|&a| ray.dot(&(x - views.views[a].centre).normalize()) >= cos_max);
+    if !close {
+        return None;
+    }
+    let at = views.project(b, k)?;
+    let radius = settings.radius * view.intrinsics.width.hypot(view.intrinsics.height);
+    let mut n = 0;
+    for j in views.neighbours(b, at, radius) {
+        if ours(j) {
+            return Some(false);
+        }
+        n += 1;
+    }
+    (n >= settings.min_neighbours).then_some(true)
+}
+
+/// The conflicts between two single images `a` and `b`, both ways: their points the other did
+/// not see, projected into the other.
+pub fn pair_counts(views: &Views, a: usize, b: usize, settings: &ConflictSettings) -> Counts {
+    let mut counts = Counts::default();
+    for (from, to) in [(a, b), (b, a)] {
+        let ours = |j: usize| views.observers[j].binary_search(&from).is_ok();
+        for &k in &views.seen_by[from] {
+            if views.observers[k].binary_search(&to).is_ok() {
+                counts.seen += 1;
                 continue;
             }
-            let Some(at) = views.project(b, k) else {
-                continue;
-            };
-            let radius = settings.radius * view.intrinsics.width.hypot(view.intrinsics.height);
-            let mut n = 0;
-            let mut shared = false;
-            for j in views.neighbours(b, at, radius) {
-                n += 1;
-                shared |= member[j][1 - group];
-            }
-            if shared {
-                counts.agreeing += 1;
-            } else if n >= settings.min_neighbours {
-                counts.conflicting += 1;
+            match judge(views, k, to, &[from], &ours, settings) {
+                Some(true) => counts.conflicting += 1,
+                Some(false) => counts.agreeing += 1,
+                None => {}
             }
         }
     }

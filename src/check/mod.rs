@@ -42,7 +42,7 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
         min_neighbours: 1,
     },
     min_group: 3,
-    threshold: 0.5,
+    threshold: 0.4,
     min_conflicts: 30,
 };
 
@@ -133,8 +133,7 @@ pub fn check_model(
     let views = Views::new(model, settings.conflict.radius)?;
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
-    let tree = splits::spanning_tree(n, &covisibility);
-    let candidates = splits::candidate_splits(n, &tree, settings.min_group);
+    let candidates = candidates(&views, &covisibility, settings);
     // The worst split: the highest ratio among those with enough conflicts to be judged, else
     // the highest ratio (reported, never ghosted).
     let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, c.ratio());
@@ -166,6 +165,59 @@ pub fn check_model(
         side,
         views: Some(views),
     })
+}
+
+/// A link between two images agrees when at least this many samples were judged...
+const PAIR_MIN_JUDGED: usize = 20;
+/// ... and at most this fraction of them conflict. Only agreeing links make the graph whose
+/// components and spectral cuts are candidate splits: links that conflict, and links too
+/// oblique to say, are left out.
+const PAIR_MAX_RATIO: f64 = 0.4;
+
+/// The candidate splits of both spanning trees: of the co-visibility graph, and of the same
+/// graph with each link weakened by its own conflict ratio (two copies seen from the same spot
+/// share the repeated object's points, so co-visibility alone links them strongly; what they
+/// see around it conflicts).
+fn candidates(
+    views: &Views,
+    covisibility: &splits::Covisibility,
+    settings: &CheckSettings,
+) -> Vec<Vec<bool>> {
+    let n = views.views.len();
+    let links: Vec<(f64, usize, usize)> = covisibility
+        .shared
+        .keys()
+        .map(|&(a, b)| (covisibility.strength(a, b), a, b))
+        .collect();
+    let pairs: Vec<Counts> = links
+        .iter()
+        .map(|&(_, a, b)| conflict::pair_counts(views, a, b, &settings.conflict))
+        .collect();
+    let consistent: Vec<(f64, usize, usize)> = links
+        .iter()
+        .zip(&pairs)
+        .map(|(&(w, a, b), c)| (w * (1.0 - c.ratio()).powi(2), a, b))
+        .collect();
+    // With only the links that agree, two copies fall apart.
+    let agreeing: Vec<(f64, usize, usize)> = links
+        .iter()
+        .zip(&pairs)
+        .filter(|(_, c)| {
+            c.conflicting + c.agreeing >= PAIR_MIN_JUDGED && c.ratio() <= PAIR_MAX_RATIO
+        })
+        .map(|(l, _)| *l)
+        .collect();
+    let min = settings.min_group;
+    let spectral = splits::spectral_splits(n, &agreeing, min);
+    let components = splits::component_splits(n, &agreeing, min);
+    let mut out = splits::candidate_splits(n, &splits::spanning_tree(n, links), min);
+    let tree = splits::candidate_splits(n, &splits::spanning_tree(n, consistent), min);
+    for side in tree.into_iter().chain(spectral).chain(components) {
+        if !out.contains(&side) {
+            out.push(side);
+        }
+    }
+    out
 }
 
 fn describe(

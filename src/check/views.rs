@@ -102,6 +102,8 @@ pub struct Views {
     pub points: Vec<Vector3<f64>>,
     /// For each point, the views observing it (sorted, no repeats).
     pub observers: Vec<Vec<usize>>,
+    /// For each view, the points it observes (sorted, no repeats).
+    pub seen_by: Vec<Vec<usize>>,
     /// Grid cell size in pixels (the neighbourhood radius).
     pub cell: f64,
 }
@@ -161,14 +163,17 @@ impl Views {
                 grid,
             });
         }
-        for o in &mut observers {
+        let mut seen_by = vec![Vec::new(); views.len()];
+        for (k, o) in observers.iter_mut().enumerate() {
             o.sort_unstable();
             o.dedup();
+            o.iter().for_each(|&v| seen_by[v].push(k));
         }
         Ok(Views {
             views,
             points,
             observers,
+            seen_by,
             cell,
         })
     }
