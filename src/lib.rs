@@ -8,6 +8,7 @@
 
 #![warn(missing_docs)]
 
+pub mod check;
 pub mod colmap;
 pub mod costs;
 #[cfg(feature = "eval")]

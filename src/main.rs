@@ -32,7 +32,8 @@ Examples:
   vgsel-colmap completions bash > /etc/bash_completion.d/vgsel-colmap
   vgsel-colmap man > vgsel-colmap.1
 
-Exit status: 0 success, 1 error (the database is left unchanged), 2 bad command line.";
+Exit status: 0 success, 1 error (the database is left unchanged), 2 bad command line;
+`check`: 3 when a model is ghosted.";
 
 /// Selects the image pairs COLMAP's mapper should use, by the min-cost network flow of Shah,
 /// Chari and Narayanan ("A Unified View-Graph Selection Framework for Structure from Motion").
@@ -62,6 +63,12 @@ enum Command {
     Prune(cli::prune::PruneArgs),
     /// Put back every pair a prune invalidated, byte for byte, and drop vgsel-colmap's tables.
     Restore(cli::args::DatabaseArg),
+    /// Is a reconstruction ghosted (copies of repeated structure registered onto each other)?
+    #[command(after_help = "Examples:
+  vgsel-colmap check --model sparse --database_path db.db --report check.json --plots plots
+
+Exit status: 0 every model clean, 3 some model ghosted, 1 error, 2 bad command line.")]
+    Check(cli::check::CheckArgs),
     /// Print the view graph's figures.
     Inspect(cli::inspect::InspectArgs),
     /// Run the selection solver on a plain-text graph (benchmarks, solver-only users).
@@ -116,10 +123,12 @@ fn main() -> ExitCode {
     let cli = parse();
     let quiet = cli.quiet;
     let progress = Progress::new(quiet, cli.verbose);
+    let mut ghosted = false;
     let result = match cli.command {
         Command::Prune(args) => cli::prune::run(&args, quiet, &progress),
         Command::Restore(args) => cli::restore::run(&args, quiet),
         Command::Inspect(args) => cli::inspect::run(&args),
+        Command::Check(args) => cli::check::run(&args).map(|g| ghosted = g),
         Command::Solve(args) => cli::solve::run(&args),
         #[cfg(feature = "eval")]
         Command::Eval(args) => cli::eval::run(&args),
@@ -143,6 +152,7 @@ fn main() -> ExitCode {
     };
     progress.finish();
     match result {
+        Ok(()) if ghosted => ExitCode::from(cli::check::EXIT_GHOSTED),
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             let mut message = format!("{e:#}").replace('\n', " ");

@@ -94,6 +94,7 @@ const PRODUCT: &[&str] = &[
     "src/outputs",
     "src/flow",
     "src/named.rs",
+    "src/check",
 ];
 
 #[test]

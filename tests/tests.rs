@@ -4,6 +4,7 @@
 mod support;
 
 mod architecture;
+mod check;
 mod cli;
 mod colmap4;
 mod crash;

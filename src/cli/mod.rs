@@ -6,6 +6,7 @@
 //! [`dashed_aliases`] adds the dashed spelling (`--num-images`) as a visible alias.
 
 pub mod args;
+pub mod check;
 #[cfg(feature = "eval")]
 pub mod eval;
 pub mod export;

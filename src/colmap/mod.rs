@@ -9,4 +9,5 @@ pub mod migration;
 pub mod model;
 pub mod rewrite;
 pub mod schema;
+pub mod sparse;
 pub mod wal;

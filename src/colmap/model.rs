@@ -254,14 +254,15 @@ fn read_binary_images(dir: &Path) -> Result<Vec<ModelImage>> {
     Ok(out)
 }
 
-struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-    path: &'a Path,
+/// A little-endian cursor over a binary model file, whose errors name the file and offset.
+pub(super) struct Reader<'a> {
+    pub(super) bytes: &'a [u8],
+    pub(super) at: usize,
+    pub(super) path: &'a Path,
 }
 
 impl Reader<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8]> {
+    pub(super) fn take(&mut self, n: usize) -> Result<&[u8]> {
         ensure!(
             self.at + n <= self.bytes.len(),
             "{}: truncated at byte {}",
@@ -271,25 +272,25 @@ impl Reader<'_> {
         self.at += n;
         Ok(&self.bytes[self.at - n..self.at])
     }
-    fn skip(&mut self, n: usize) -> Result<()> {
+    pub(super) fn skip(&mut self, n: usize) -> Result<()> {
         self.take(n).map(|_| ())
     }
-    fn u32(&mut self) -> Result<u32> {
+    pub(super) fn u32(&mut self) -> Result<u32> {
         Ok(u32::from_le_bytes(
             self.take(4)?.try_into().expect("4 bytes"),
         ))
     }
-    fn u64(&mut self) -> Result<u64> {
+    pub(super) fn u64(&mut self) -> Result<u64> {
         Ok(u64::from_le_bytes(
             self.take(8)?.try_into().expect("8 bytes"),
         ))
     }
-    fn f64(&mut self) -> Result<f64> {
+    pub(super) fn f64(&mut self) -> Result<f64> {
         Ok(f64::from_le_bytes(
             self.take(8)?.try_into().expect("8 bytes"),
         ))
     }
-    fn name(&mut self) -> Result<String> {
+    pub(super) fn name(&mut self) -> Result<String> {
         let rest = &self.bytes[self.at..];
         let end = rest
             .iter()

@@ -1,0 +1,280 @@
+//! The model check: is a reconstruction ghosted (two copies of repeated structure registered
+//! onto each other), and where? Without ground truth, from the model and its database alone.
+//!
+//! Every image of a model is a view ([`views`]); the co-visibility graph's maximum spanning tree
+//! offers candidate splits into two groups ([`splits`]); each split is scored by conflicting
+//! observations ([`conflict`]); a model whose worst split's conflict ratio reaches the
+//! threshold is ghosted, and the report names the two groups and the database pairs that join
+//! them. docs/check.md gives the method, what it assumes and its measurements.
+
+pub mod conflict;
+pub mod plot;
+pub mod splits;
+pub mod views;
+
+use crate::colmap::database::Database;
+use crate::colmap::sparse::SparseModel;
+use anyhow::Result;
+use conflict::{ConflictSettings, Counts};
+use serde::Serialize;
+use std::collections::{BTreeMap, HashSet};
+use views::Views;
+
+/// Everything the check's verdict depends on.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct CheckSettings {
+    /// How conflicts are counted.
+    pub conflict: ConflictSettings,
+    /// Images each group of a split needs at least.
+    pub min_group: usize,
+    /// Conflict ratio from which a split is two copies.
+    pub threshold: f64,
+    /// Conflicting samples a split needs at least to be called two copies (few samples say
+    /// little).
+    pub min_conflicts: usize,
+}
+
+/// The defaults, the one setting of docs/check.md's measurements.
+pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
+    conflict: ConflictSettings {
+        max_angle_deg: 30.0,
+        radius: 0.02,
+        min_neighbours: 1,
+    },
+    min_group: 3,
+    threshold: 0.4,
+    min_conflicts: 30,
+};
+
+/// A database pair (verified, not invalidated by a prune) between the two groups.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct JoiningPair {
+    /// Image of the first group.
+    pub image1: String,
+    /// Image of the second group.
+    pub image2: String,
+    /// Its verified inliers.
+    pub inliers: usize,
+    /// 3D points the two images share in the model.
+    pub shared_points: usize,
+}
+
+/// The split with the highest conflict ratio.
+#[derive(Clone, Debug, Serialize)]
+pub struct Split {
+    /// The two groups' image names (the first holds the model's first image).
+    pub groups: [Vec<String>; 2],
+    /// Its counts.
+    pub counts: Counts,
+    /// Conflict ratio: conflicting over judged samples.
+    pub ratio: f64,
+    /// Database pairs between the groups, most inliers first (model links where the check ran
+    /// without a database).
+    pub joining_pairs: Vec<JoiningPair>,
+}
+
+/// The check of one model.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelCheck {
+    /// Registered images.
+    pub images: usize,
+    /// 3D points.
+    pub points: usize,
+    /// Candidate splits scored.
+    pub splits_scored: usize,
+    /// The verdict: the worst split reaches the threshold with enough conflicts.
+    pub ghosted: bool,
+    /// The worst split's conflict ratio (0 without a split).
+    pub score: f64,
+    /// The worst split, if the model could be split at all.
+    pub worst: Option<Split>,
+    /// Which group each image is in (0 or 1) for the worst split, by image name.
+    #[serde(skip)]
+    pub side: Vec<bool>,
+    /// The views (for plots).
+    #[serde(skip)]
+    pub views: Option<Views>,
+}
+
+/// Verified pairs of `db` by image names (in name order) with their inliers, without the pairs
+/// a prune invalidated: the pairs a mapper run on `db` could use.
+pub fn database_pairs(db: &Database) -> Result<BTreeMap<(String, String), usize>> {
+    let names: BTreeMap<u32, String> = db
+        .images()?
+        .into_iter()
+        .map(|im| (im.image_id, im.name))
+        .collect();
+    let invalid: HashSet<u64> = db.invalidated_pair_ids()?;
+    let mut out = BTreeMap::new();
+    for g in db.geometries()? {
+        let id = crate::colmap::ids::pair_id(g.image_id1, g.image_id2);
+        if invalid.contains(&id) {
+            continue;
+        }
+        if let (Some(a), Some(b)) = (names.get(&g.image_id1), names.get(&g.image_id2)) {
+            let key = if a < b {
+                (a.clone(), b.clone())
+            } else {
+                (b.clone(), a.clone())
+            };
+            out.insert(key, g.num_inliers);
+        }
+    }
+    Ok(out)
+}
+
+/// Checks one model. `pairs` are [`database_pairs`] (`None`: joining pairs are the model's
+/// cross-group links).
+pub fn check_model(
+    model: &SparseModel,
+    pairs: Option<&BTreeMap<(String, String), usize>>,
+    settings: &CheckSettings,
+) -> Result<ModelCheck> {
+    let views = Views::new(model, settings.conflict.radius)?;
+    let n = views.views.len();
+    let covisibility = splits::Covisibility::new(&views);
+    let candidates = candidates(&views, &covisibility, settings);
+    // The worst split: the highest ratio among those with enough conflicts to be judged, else
+    // the highest ratio (reported, never ghosted).
+    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, c.ratio());
+    let mut worst: Option<(Vec<bool>, Counts)> = None;
+    for side in &candidates {
+        let counts = conflict::count(&views, side, &settings.conflict);
+        if worst.as_ref().is_none_or(|w| rank(&counts) > rank(&w.1)) {
+            worst = Some((side.clone(), counts));
+        }
+    }
+    let (side, split) = match worst {
+        Some((side, counts)) => {
+            let split = describe(&views, &covisibility, &side, counts, pairs);
+            (side, Some(split))
+        }
+        None => (vec![false; n], None),
+    };
+    let score = split.as_ref().map_or(0.0, |s| s.ratio);
+    let ghosted = split.as_ref().is_some_and(|s| {
+        s.ratio >= settings.threshold && s.counts.conflicting >= settings.min_conflicts
+    });
+    Ok(ModelCheck {
+        images: n,
+        points: views.points.len(),
+        splits_scored: candidates.len(),
+        ghosted,
+        score,
+        worst: split,
+        side,
+        views: Some(views),
+    })
+}
+
+/// A link between two images agrees when at least this many samples were judged...
+const PAIR_MIN_JUDGED: usize = 20;
+/// ... and at most this fraction of them conflict. Only agreeing links make the graph whose
+/// components and spectral cuts are candidate splits: links that conflict, and links too
+/// oblique to say, are left out.
+const PAIR_MAX_RATIO: f64 = 0.4;
+
+/// The candidate splits of both spanning trees: of the co-visibility graph, and of the same
+/// graph with each link weakened by its own conflict ratio (two copies seen from the same spot
+/// share the repeated object's points, so co-visibility alone links them strongly; what they
+/// see around it conflicts).
+fn candidates(
+    views: &Views,
+    covisibility: &splits::Covisibility,
+    settings: &CheckSettings,
+) -> Vec<Vec<bool>> {
+    let n = views.views.len();
+    let links: Vec<(f64, usize, usize)> = covisibility
+        .shared
+        .keys()
+        .map(|&(a, b)| (covisibility.strength(a, b), a, b))
+        .collect();
+    let pairs: Vec<Counts> = links
+        .iter()
+        .map(|&(_, a, b)| conflict::pair_counts(views, a, b, &settings.conflict))
+        .collect();
+    let consistent: Vec<(f64, usize, usize)> = links
+        .iter()
+        .zip(&pairs)
+        .map(|(&(w, a, b), c)| (w * (1.0 - c.ratio()).powi(2), a, b))
+        .collect();
+    // With only the links that agree, two copies fall apart.
+    let agreeing: Vec<(f64, usize, usize)> = links
+        .iter()
+        .zip(&pairs)
+        .filter(|(_, c)| {
+            c.conflicting + c.agreeing >= PAIR_MIN_JUDGED && c.ratio() <= PAIR_MAX_RATIO
+        })
+        .map(|(l, _)| *l)
+        .collect();
+    let min = settings.min_group;
+    let spectral = splits::spectral_splits(n, &agreeing, min);
+    let components = splits::component_splits(n, &agreeing, min);
+    let mut out = splits::candidate_splits(n, &splits::spanning_tree(n, links), min);
+    let tree = splits::candidate_splits(n, &splits::spanning_tree(n, consistent), min);
+    for side in tree.into_iter().chain(spectral).chain(components) {
+        if !out.contains(&side) {
+            out.push(side);
+        }
+    }
+    out
+}
+
+fn describe(
+    views: &Views,
+    covisibility: &splits::Covisibility,
+    side: &[bool],
+    counts: Counts,
+    pairs: Option<&BTreeMap<(String, String), usize>>,
+) -> Split {
+    let names = |s: bool| -> Vec<String> {
+        let mut g: Vec<String> = (0..side.len())
+            .filter(|&v| side[v] == s)
+            .map(|v| views.views[v].name.clone())
+            .collect();
+        g.sort();
+        g
+    };
+    let mut joining = Vec::new();
+    for a in (0..side.len()).filter(|&v| !side[v]) {
+        for b in (0..side.len()).filter(|&v| side[v]) {
+            let shared = covisibility
+                .shared
+                .get(&(a.min(b), a.max(b)))
+                .copied()
+                .unwrap_or(0);
+            let (na, nb) = (&views.views[a].name, &views.views[b].name);
+            let key = if na < nb {
+                (na.clone(), nb.clone())
+            } else {
+                (nb.clone(), na.clone())
+            };
+            let inliers = match pairs {
+                Some(p) => p.get(&key).copied().unwrap_or(0),
+                None => 0,
+            };
+            if inliers > 0 || (pairs.is_none() && shared > 0) {
+                joining.push(JoiningPair {
+                    image1: na.clone(),
+                    image2: nb.clone(),
+                    inliers,
+                    shared_points: shared,
+                });
+            }
+        }
+    }
+    joining.sort_by(|x, y| {
+        (y.inliers, y.shared_points)
+            .cmp(&(x.inliers, x.shared_points))
+            .then((&x.image1, &x.image2).cmp(&(&y.image1, &y.image2)))
+    });
+    Split {
+        groups: [names(false), names(true)],
+        counts,
+        ratio: counts.ratio(),
+        joining_pairs: joining,
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,186 @@
+//! Where a model could be two copies glued together: the co-visibility graph of its images and
+//! the candidate splits into two groups, one per edge of its maximum spanning tree.
+//!
+//! Two copies registered onto each other are two groups of images that see much of their own
+//! structure and little of the other's; the weakest links of the strongest tree between images
+//! are where such groups meet (Heinly et al., ECCV 2014, split along a spanning tree too).
+
+use super::views::Views;
+use std::collections::BTreeMap;
+
+/// Shared 3D points per image pair (smaller view index first), and points per view.
+#[derive(Clone, Debug)]
+pub struct Covisibility {
+    /// Points seen by both views of the pair.
+    pub shared: BTreeMap<(usize, usize), usize>,
+    /// Points seen by each view.
+    pub seen: Vec<usize>,
+}
+
+impl Covisibility {
+    /// Counts shared points over every track.
+    pub fn new(views: &Views) -> Covisibility {
+        let mut shared = BTreeMap::new();
+        let mut seen = vec![0; views.views.len()];
+        for track in &views.observers {
+            for (i, &a) in track.iter().enumerate() {
+                seen[a] += 1;
+                for &b in &track[i + 1..] {
+                    *shared.entry((a, b)).or_insert(0) += 1;
+                }
+            }
+        }
+        Covisibility { shared, seen }
+    }
+
+    /// The link's strength: shared points over the smaller view's points, in [0, 1].
+    pub fn strength(&self, a: usize, b: usize) -> f64 {
+        let key = (a.min(b), a.max(b));
+        let shared = self.shared.get(&key).copied().unwrap_or(0) as f64;
+        shared / self.seen[a].min(self.seen[b]).max(1) as f64
+    }
+}
+
+/// Union-find over view indices.
+struct Sets(Vec<usize>);
+
+impl Sets {
+    fn find(&mut self, a: usize) -> usize {
+        let mut r = a;
+        while self.0[r] != r {
+            r = self.0[r];
+        }
+        self.0[a] = r;
+        r
+    }
+}
+
+/// The maximum spanning forest of a graph given as (weight, view, view) edges (Kruskal, ties
+/// by view indices).
+pub fn spanning_tree(n: usize, mut edges: Vec<(f64, usize, usize)>) -> Vec<(usize, usize)> {
+    edges.sort_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let mut sets = Sets((0..n).collect());
+    let mut tree = Vec::new();
+    for (_, a, b) in edges {
+        let (ra, rb) = (sets.find(a), sets.find(b));
+        if ra != rb {
+            sets.0[ra] = rb;
+            tree.push((a, b));
+        }
+    }
+    tree
+}
+
+/// Each split the tree offers with both sides at least `min_group` views, once each: `true`
+/// marks the side cut off (the one without view 0). In a forest, the other trees stay with
+/// view 0's side.
+pub fn candidate_splits(n: usize, tree: &[(usize, usize)], min_group: usize) -> Vec<Vec<bool>> {
+    let mut out: Vec<Vec<bool>> = Vec::new();
+    for cut in 0..tree.len() {
+        let mut adjacent = vec![Vec::new(); n];
+        for (k, &(a, b)) in tree.iter().enumerate() {
+            if k != cut {
+                adjacent[a].push(b);
+                adjacent[b].push(a);
+            }
+        }
+        // The side of the cut edge's second view.
+        let mut side = vec![false; n];
+        let mut stack = vec![tree[cut].1];
+        side[tree[cut].1] = true;
+        while let Some(v) = stack.pop() {
+            for &w in &adjacent[v] {
+                if !side[w] {
+                    side[w] = true;
+                    stack.push(w);
+                }
+            }
+        }
+        if side[0] {
+            side.iter_mut().for_each(|s| *s = !*s);
+        }
+        let b = side.iter().filter(|s| **s).count();
+        if b >= min_group && n - b >= min_group && !out.contains(&side) {
+            out.push(side);
+        }
+    }
+    out
+}
+
+/// The sweep cuts of the graph's spectral embedding: images ordered by the Fiedler vector of
+/// the normalised Laplacian (Shi and Malik's normalised cut, relaxed), every prefix with at
+/// least `min_group` images on both sides. Global where a spanning tree is local: one weak link
+/// inside a copy does not hide the copies.
+pub fn spectral_splits(
+    n: usize,
+    edges: &[(f64, usize, usize)],
+    min_group: usize,
+) -> Vec<Vec<bool>> {
+    if n < 2 * min_group.max(1) {
+        return Vec::new();
+    }
+    let mut w = nalgebra::DMatrix::<f64>::zeros(n, n);
+    for &(x, a, b) in edges {
+        w[(a, b)] += x.max(0.0);
+        w[(b, a)] += x.max(0.0);
+    }
+    let d: Vec<f64> = (0..n).map(|i| w.row(i).sum().max(1e-12)).collect();
+    let l = nalgebra::DMatrix::from_fn(n, n, |i, j| {
+        f64::from(u8::from(i == j)) - w[(i, j)] / (d[i] * d[j]).sqrt()
+    });
+    let eigen = l.symmetric_eigen();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        eigen.eigenvalues[a]
+            .total_cmp(&eigen.eigenvalues[b])
+            .then(a.cmp(&b))
+    });
+    let fiedler = eigen.eigenvectors.column(order[1]);
+    let y: Vec<f64> = (0..n).map(|i| fiedler[i] / d[i].sqrt()).collect();
+    let mut by_value: Vec<usize> = (0..n).collect();
+    by_value.sort_by(|&a, &b| y[a].total_cmp(&y[b]).then(a.cmp(&b)));
+    let mut out = Vec::new();
+    for k in min_group..=n - min_group {
+        let mut side = vec![false; n];
+        by_value[k..].iter().for_each(|&v| side[v] = true);
+        if side[0] {
+            side.iter_mut().for_each(|s| *s = !*s);
+        }
+        if !out.contains(&side) {
+            out.push(side);
+        }
+    }
+    out
+}
+
+/// Each connected component of the graph of `edges` with at least `min_group` views, and at
+/// least as many outside it, against the rest.
+pub fn component_splits(
+    n: usize,
+    edges: &[(f64, usize, usize)],
+    min_group: usize,
+) -> Vec<Vec<bool>> {
+    let mut sets = Sets((0..n).collect());
+    for &(_, a, b) in edges {
+        let (ra, rb) = (sets.find(a), sets.find(b));
+        if ra != rb {
+            sets.0[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    let roots: Vec<usize> = (0..n).map(|v| sets.find(v)).collect();
+    let mut out = Vec::new();
+    for root in 0..n {
+        let mut side: Vec<bool> = roots.iter().map(|&r| r == root).collect();
+        let size = side.iter().filter(|s| **s).count();
+        if size < min_group || n - size < min_group {
+            continue;
+        }
+        if side[0] {
+            side.iter_mut().for_each(|s| *s = !*s);
+        }
+        if !out.contains(&side) {
+            out.push(side);
+        }
+    }
+    out
+}

@@ -1,0 +1,207 @@
+//! A model made ready for the check: each registered image with its centre, its projection
+//! (pinhole plus COLMAP's radial/tangential distortion) and a grid of its triangulated
+//! keypoints; each 3D point with the images that observe it.
+
+use crate::colmap::model::ModelCamera;
+use crate::colmap::sparse::SparseModel;
+use anyhow::{Context, Result};
+use nalgebra::{Matrix3, Vector3};
+use std::collections::{BTreeMap, HashMap};
+
+/// Intrinsics as a pinhole with up to two radial and two tangential coefficients (OpenCV's
+/// meaning, which is COLMAP's for the models it names alike).
+#[derive(Clone, Debug)]
+pub struct Intrinsics {
+    f: [f64; 2],
+    c: [f64; 2],
+    k: [f64; 2],
+    p: [f64; 2],
+    /// Image width in pixels.
+    pub width: f64,
+    /// Image height in pixels.
+    pub height: f64,
+}
+
+impl Intrinsics {
+    /// From a model camera; the fisheye and FOV models are taken as their pinhole part (their
+    /// distortion shifts a projection by a few pixels at most where the check looks).
+    pub fn from_camera(c: &ModelCamera) -> Intrinsics {
+        let p = &c.params;
+        let at = |k: usize| p.get(k).copied().unwrap_or(0.0);
+        let (f, cc, k, t) = match c.model.as_str() {
+            "SIMPLE_PINHOLE" => ([at(0); 2], [at(1), at(2)], [0.0; 2], [0.0; 2]),
+            "PINHOLE" => ([at(0), at(1)], [at(2), at(3)], [0.0; 2], [0.0; 2]),
+            "SIMPLE_RADIAL" => ([at(0); 2], [at(1), at(2)], [at(3), 0.0], [0.0; 2]),
+            "RADIAL" => ([at(0); 2], [at(1), at(2)], [at(3), at(4)], [0.0; 2]),
+            "OPENCV" | "FULL_OPENCV" => (
+                [at(0), at(1)],
+                [at(2), at(3)],
+                [at(4), at(5)],
+                [at(6), at(7)],
+            ),
+            _ if p.len() >= 4 && c.model.contains("OPENCV") => {
+                ([at(0), at(1)], [at(2), at(3)], [0.0; 2], [0.0; 2])
+            }
+            _ => ([at(0); 2], [at(1), at(2)], [0.0; 2], [0.0; 2]),
+        };
+        Intrinsics {
+            f,
+            c: cc,
+            k,
+            p: t,
+            width: c.width as f64,
+            height: c.height as f64,
+        }
+    }
+
+    /// Pixel position of a point in camera coordinates, if in front and inside the image.
+    pub fn project(&self, x: &Vector3<f64>) -> Option<[f64; 2]> {
+        if x.z <= 1e-9 {
+            return None;
+        }
+        let (u, v) = (x.x / x.z, x.y / x.z);
+        let r2 = u * u + v * v;
+        let radial = 1.0 + self.k[0] * r2 + self.k[1] * r2 * r2;
+        let du = 2.0 * self.p[0] * u * v + self.p[1] * (r2 + 2.0 * u * u);
+        let dv = self.p[0] * (r2 + 2.0 * v * v) + 2.0 * self.p[1] * u * v;
+        let px = self.f[0] * (u * radial + du) + self.c[0];
+        let py = self.f[1] * (v * radial + dv) + self.c[1];
+        let inside = px >= 0.0 && py >= 0.0 && px < self.width && py < self.height;
+        // Strong distortion folds far-off points back into the image: refuse them.
+        (inside && r2 < 4.0).then_some([px, py])
+    }
+}
+
+/// Triangulated keypoints by grid cell: (pixel x, y; point index). Only looked up, never
+/// iterated, so the hash order cannot reach a result.
+pub type Grid = HashMap<(i64, i64), Vec<([f64; 2], usize)>>;
+
+/// One registered image, ready to project into.
+#[derive(Clone, Debug)]
+pub struct View {
+    /// Image name.
+    pub name: String,
+    /// World-to-camera rotation.
+    pub rotation: Matrix3<f64>,
+    /// World-to-camera translation.
+    pub translation: Vector3<f64>,
+    /// Camera centre in the world.
+    pub centre: Vector3<f64>,
+    /// The camera's intrinsics.
+    pub intrinsics: Intrinsics,
+    /// Triangulated keypoints in grid cells of [`Views::cell`] pixels: (x, y, point index).
+    pub grid: Grid,
+}
+
+/// The model as the check reads it. Points and views are indexed densely, in id order.
+#[derive(Clone, Debug)]
+pub struct Views {
+    /// Registered images, in image-id order.
+    pub views: Vec<View>,
+    /// 3D point positions.
+    pub points: Vec<Vector3<f64>>,
+    /// For each point, the views observing it (sorted, no repeats).
+    pub observers: Vec<Vec<usize>>,
+    /// For each view, the points it observes (sorted, no repeats).
+    pub seen_by: Vec<Vec<usize>>,
+    /// Grid cell size in pixels (the neighbourhood radius).
+    pub cell: f64,
+}
+
+impl Views {
+    /// Prepares `model`; `radius` is the neighbourhood radius as a fraction of each image's
+    /// diagonal (the grid is built for the largest image's radius).
+    pub fn new(model: &SparseModel, radius: f64) -> Result<Views> {
+        let cameras: BTreeMap<u32, &ModelCamera> =
+            model.cameras.iter().map(|c| (c.camera_id, c)).collect();
+        let index: BTreeMap<u64, usize> = model
+            .points
+            .keys()
+            .enumerate()
+            .map(|(k, id)| (*id, k))
+            .collect();
+        let points = model
+            .points
+            .values()
+            .map(|p| Vector3::new(p[0], p[1], p[2]))
+            .collect();
+        let diagonal = cameras
+            .values()
+            .map(|c| (c.width as f64).hypot(c.height as f64))
+            .fold(1.0, f64::max);
+        let cell = (radius * diagonal).max(1.0);
+        let mut images: Vec<_> = model.images.iter().collect();
+        images.sort_by_key(|im| im.image.image_id);
+        let mut observers = vec![Vec::new(); index.len()];
+        let mut views = Vec::new();
+        for (v, im) in images.iter().enumerate() {
+            let camera = cameras.get(&im.image.camera_id).with_context(|| {
+                format!(
+                    "image {} names camera {}, which the model lacks",
+                    im.image.name, im.image.camera_id
+                )
+            })?;
+            let mut grid = Grid::new();
+            for p in &im.points2d {
+                let Some(k) = p.point3d_id.and_then(|id| index.get(&id)) else {
+                    continue;
+                };
+                observers[*k].push(v);
+                let key = (
+                    (p.xy[0] / cell).floor() as i64,
+                    (p.xy[1] / cell).floor() as i64,
+                );
+                grid.entry(key).or_default().push((p.xy, *k));
+            }
+            let rotation = im.image.rotation.to_rotation_matrix().into_inner();
+            views.push(View {
+                name: im.image.name.clone(),
+                rotation,
+                translation: im.image.translation,
+                centre: im.image.centre(),
+                intrinsics: Intrinsics::from_camera(camera),
+                grid,
+            });
+        }
+        let mut seen_by = vec![Vec::new(); views.len()];
+        for (k, o) in observers.iter_mut().enumerate() {
+            o.sort_unstable();
+            o.dedup();
+            o.iter().for_each(|&v| seen_by[v].push(k));
+        }
+        Ok(Views {
+            views,
+            points,
+            observers,
+            seen_by,
+            cell,
+        })
+    }
+
+    /// The points observed by view `v` within `radius` pixels of `at` (indices, may repeat).
+    pub fn neighbours(
+        &self,
+        v: usize,
+        at: [f64; 2],
+        radius: f64,
+    ) -> impl Iterator<Item = usize> + '_ {
+        let (cx, cy) = (
+            (at[0] / self.cell).floor() as i64,
+            (at[1] / self.cell).floor() as i64,
+        );
+        let grid = &self.views[v].grid;
+        (cx - 1..=cx + 1)
+            .flat_map(move |x| (cy - 1..=cy + 1).map(move |y| (x, y)))
+            .filter_map(move |key| grid.get(&key))
+            .flatten()
+            .filter(move |(xy, _)| (xy[0] - at[0]).hypot(xy[1] - at[1]) <= radius)
+            .map(|(_, k)| *k)
+    }
+
+    /// Pixel position of point `k` in view `v`, if in front and inside the image.
+    pub fn project(&self, v: usize, k: usize) -> Option<[f64; 2]> {
+        let view = &self.views[v];
+        view.intrinsics
+            .project(&(view.rotation * self.points[k] + view.translation))
+    }
+}

@@ -1,0 +1,137 @@
+//! `check`: is a reconstruction ghosted, and where? One line per model, a JSON report, a top
+//! view per model, and an exit status a pipeline can branch on (3: ghosted).
+
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use vgsel_colmap::check::{self, CheckSettings, ModelCheck, DEFAULT_SETTINGS};
+use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::model::model_dirs;
+use vgsel_colmap::colmap::sparse::read_sparse_model;
+
+/// Exit status of a check that found a ghosted model.
+pub const EXIT_GHOSTED: u8 = 3;
+
+#[derive(Args)]
+#[command(rename_all = "snake_case")]
+pub struct CheckArgs {
+    /// A COLMAP model folder (binary or text), or a folder of sub-models (mapper's output_path):
+    /// each is checked.
+    #[arg(long, value_name = "DIR")]
+    model: PathBuf,
+    /// The database the model was made from: names the verified pairs that join the groups.
+    #[arg(long, value_name = "DB")]
+    database_path: Option<PathBuf>,
+    /// Write the JSON report to FILE.
+    #[arg(long, value_name = "FILE")]
+    report: Option<PathBuf>,
+    /// Write each model's top view (cameras coloured by group) as SVG into DIR.
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
+    /// Conflict ratio from which a model is ghosted.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = super::args::fraction)]
+    threshold: f64,
+    /// Expert: largest angle (degrees) between two images' rays for one to be expected to see
+    /// what the other saw.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
+    max_angle: f64,
+    /// Expert: neighbourhood radius around a projected point, as a fraction of the image diagonal.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.radius, value_parser = super::args::fraction)]
+    radius: f64,
+    /// Expert: images each group needs at least.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.min_group)]
+    min_group: usize,
+    /// Expert: conflicting samples a ghosted split needs at least.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.min_conflicts)]
+    min_conflicts: usize,
+}
+
+impl CheckArgs {
+    fn settings(&self) -> CheckSettings {
+        let mut s = DEFAULT_SETTINGS;
+        s.threshold = self.threshold;
+        s.conflict.max_angle_deg = self.max_angle;
+        s.conflict.radius = self.radius;
+        s.min_group = self.min_group.max(1);
+        s.min_conflicts = self.min_conflicts;
+        s
+    }
+}
+
+/// The line a model gets: its verdict, score and groups.
+fn verdict_line(dir: &Path, c: &ModelCheck) -> String {
+    let what = if c.ghosted { "GHOSTED" } else { "clean" };
+    let mut line = format!("{}: {what} (conflict ratio {:.2}", dir.display(), c.score);
+    if let Some(w) = &c.worst {
+        line += &format!(
+            ", {} conflicting of {} judged; groups of {} and {} images",
+            w.counts.conflicting,
+            w.counts.conflicting + w.counts.agreeing,
+            w.groups[0].len(),
+            w.groups[1].len()
+        );
+        if c.ghosted {
+            let pairs: Vec<String> = w
+                .joining_pairs
+                .iter()
+                .take(3)
+                .map(|p| format!("{}-{}", p.image1, p.image2))
+                .collect();
+            line += &format!(
+                "; {} joining pairs, e.g. {}",
+                w.joining_pairs.len(),
+                pairs.join(" ")
+            );
+        }
+    }
+    line + ")"
+}
+
+/// Runs the check; Ok(true) when some model is ghosted.
+pub fn run(args: &CheckArgs) -> Result<bool> {
+    let settings = args.settings();
+    let pairs = match &args.database_path {
+        Some(path) => Some(check::database_pairs(&Database::open_read_only(path)?)?),
+        None => None,
+    };
+    let dirs = model_dirs(&args.model)?;
+    anyhow::ensure!(
+        !dirs.is_empty(),
+        "no COLMAP model in {}",
+        args.model.display()
+    );
+    let mut reports = Vec::new();
+    let mut ghosted = false;
+    for (k, dir) in dirs.iter().enumerate() {
+        let model = read_sparse_model(dir)?;
+        let result = check::check_model(&model, pairs.as_ref(), &settings)?;
+        println!("{}", verdict_line(dir, &result));
+        if let (Some(plots), Some(views)) = (&args.plots, &result.views) {
+            std::fs::create_dir_all(plots)
+                .with_context(|| format!("creating {}", plots.display()))?;
+            let title = format!(
+                "{}: {} (conflict ratio {:.2})",
+                dir.display(),
+                if result.ghosted { "ghosted" } else { "clean" },
+                result.score
+            );
+            check::plot::top_view(
+                views,
+                &result.side,
+                &title,
+                &plots.join(format!("top_view_{k}.svg")),
+            )?;
+        }
+        ghosted |= result.ghosted;
+        let mut value = serde_json::to_value(&result)?;
+        value["model"] = dir.display().to_string().into();
+        reports.push(value);
+    }
+    if let Some(path) = &args.report {
+        let report =
+            serde_json::json!({ "ghosted": ghosted, "settings": settings, "models": reports });
+        std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(ghosted)
+}

@@ -1,0 +1,130 @@
+//! `vgsel-colmap check`: its command-line contract (exit 0 clean, 3 ghosted, 1 error, 2 bad
+//! command line; the report and the plots), and its verdict on real COLMAP 3.8 models of the
+//! rendered duplicate scene (20 images of 480x360; about 40 s on 2 cores), against the ground
+//! truth's.
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+use vgsel_colmap::eval::render::{Scene, SceneKind};
+
+fn vgsel(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .args(args)
+        .output()
+        .expect("running vgsel-colmap")
+}
+
+/// A text model of two images and no points: nothing to split, so clean.
+fn tiny_model(dir: &Path) {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        dir.join("cameras.txt"),
+        "1 SIMPLE_PINHOLE 480 360 400 240 180\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("images.txt"),
+        "1 1 0 0 0 0 0 0 1 a.png\n\n2 1 0 0 0 1 0 0 1 b.png\n\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("points3D.txt"), "").unwrap();
+}
+
+#[test]
+fn check_exit_statuses_report_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("sparse/0");
+    tiny_model(&model);
+    let report = dir.path().join("check.json");
+    let plots = dir.path().join("plots");
+    let sparse = dir.path().join("sparse");
+    let out = vgsel(&[
+        "check",
+        "--model",
+        sparse.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--plots",
+        plots.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let line = String::from_utf8(out.stdout).unwrap();
+    assert!(line.contains("clean"), "{line}");
+    let value: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(value["ghosted"], false);
+    assert_eq!(value["models"][0]["images"], 2);
+    assert!(plots.join("top_view_0.svg").is_file());
+    let missing = dir.path().join("nothing");
+    let out = vgsel(&["check", "--model", missing.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let out = vgsel(&[
+        "check",
+        "--model",
+        sparse.to_str().unwrap(),
+        "--threshold",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+}
+
+/// Ghosted by the ground truth: at least 2 and 20% of the registered images wrong (the rule of
+/// scripts/lab/check-table.py).
+fn truth_ghosted(eval: &Value) -> bool {
+    let registered = eval["registered"].as_u64().unwrap();
+    let wrong = registered - eval["correct"].as_u64().unwrap();
+    wrong >= 2 && wrong * 5 >= registered
+}
+
+#[test]
+fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::build(SceneKind::Duplicate, 20, 1).unwrap();
+    scene.write(dir.path()).unwrap();
+    let work = dir.path().join("work");
+    let out = Command::new("bash")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/pipeline.sh"))
+        .args([
+            dir.path().join("images"),
+            work.clone(),
+            dir.path().join("gt"),
+        ])
+        .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .env("MAX_FEATURES", "1024")
+        .env("PRUNE_ARGS", "--preset disambiguation")
+        .env("CAMERA_PARAMS", "400,240,180,0")
+        .output()
+        .expect("running scripts/pipeline.sh");
+    assert!(out.status.success(), "pipeline failed: {out:?}");
+    let mut verdicts = Vec::new();
+    for variant in ["full", "pruned"] {
+        let eval: Value = serde_json::from_str(
+            &std::fs::read_to_string(work.join(format!("eval_{variant}.json"))).unwrap(),
+        )
+        .unwrap();
+        let model = work.join(format!("sparse_{variant}"));
+        let db = work.join(format!("{variant}.db"));
+        let out = vgsel(&[
+            "check",
+            "--model",
+            model.to_str().unwrap(),
+            "--database_path",
+            db.to_str().unwrap(),
+        ]);
+        let line = String::from_utf8_lossy(&out.stdout).to_string();
+        eprintln!(
+            "{variant}: {} of {} correct; {line}",
+            eval["correct"], eval["registered"]
+        );
+        // One model each (COLMAP 3.8 registers all 20 here): exit 3 is that model's verdict.
+        assert!(matches!(out.status.code(), Some(0 | 3)), "{out:?}");
+        assert_eq!(
+            out.status.code() == Some(3),
+            truth_ghosted(&eval),
+            "{variant}: {line}"
+        );
+        verdicts.push(out.status.code());
+    }
+    // The full database ghosts and the pruned one does not, as a rule (tests/e2e.rs): recorded.
+    eprintln!("exit statuses full, pruned: {verdicts:?}");
+}
