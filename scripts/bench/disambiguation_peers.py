@@ -199,10 +199,12 @@ METHODS = {"full": "full database", "disambiguation": "`--preset disambiguation`
 def verdict(run, truth):
     judged = run["images"] - len(truth["uncertain"])
     cell = f"{run['correct_agreed']}/{judged}"
-    if run["correct_agreed"] == judged:
+    whole = run["models"] == 1 and run["registered"] == run["images"]
+    if whole and run["correct_agreed"] == judged:
         cell = f"**{cell}**"
-    if run["models"] != 1 or run["registered"] < run["images"]:
-        cell += f" ({run['registered']} reg., {run['models']} models)"
+    if not whole:
+        models = "1 model" if run["models"] == 1 else f"{run['models']} models"
+        cell += f" ({run['registered']} reg., {models})"
     return cell
 
 
