@@ -116,7 +116,7 @@ for scene in "${scenes[@]}"; do
     for m in $methods; do runs+=(--run "$(spec "$m" "$v" colmap3.8 "$dir")"); done
     for m in $global_methods; do runs+=(--run "$(spec "$m" "$v" global "$dir")"); done
   done
-  echo "disambiguation-peers: $scene: ${#runs[@]} runs (logs in $dir/measure)" >&2
+  echo "disambiguation-peers: $scene: $(( ${#runs[@]} / 2 )) runs (logs in $dir/measure)" >&2
   "${measure[@]}" "${runs[@]}" >/dev/null
 done
 python3 "$helper" table "$work" "${scenes[@]}" | tee "$work/table.md"

@@ -27,7 +27,6 @@ The sweep (`*-best`) is an oracle that favours the peer: of thresholds 0.00, 0.0
 takes the one whose kept pairs connect the most images, then keep the fewest false pairs, then
 the most true pairs, judged by the same pair labels the table reports.
 """
-import csv
 import json
 import os
 import shutil
@@ -102,33 +101,11 @@ def scores(peers, db, out):
         np.save(target, np.load(saved))
 
 
-def read_labels(path):
-    with open(path) as f:
-        return {(int(r["image_id1"]), int(r["image_id2"])): r["true_pair"] == "1"
-                for r in csv.DictReader(f)}
-
-
-def components(nodes, pairs):
-    """The largest connected component's size."""
-    parent = {n: n for n in nodes}
-    def find(n):
-        while parent[n] != n:
-            parent[n] = parent[parent[n]]
-            n = parent[n]
-        return n
-    for a, b in pairs:
-        parent[find(a)] = find(b)
-    sizes = {}
-    for n in nodes:
-        sizes[find(n)] = sizes.get(find(n), 0) + 1
-    return max(sizes.values(), default=0)
-
-
 def select(db, labels_path, out):
     import numpy as np
-    from colmap_files import view_graph
+    from colmap_files import component_sizes, pair_labels, view_graph
     names, pairs = view_graph(db)
-    labels = read_labels(labels_path)
+    labels = pair_labels(labels_path)
     keep_dir = os.path.join(out, "keep")
     os.makedirs(keep_dir, exist_ok=True)
     def kept(valid):
@@ -139,7 +116,7 @@ def select(db, labels_path, out):
     def counts(chosen):
         return {"pairs": len(chosen), "false": sum(not labels.get(p, True) for p in chosen),
                 "true": sum(labels.get(p, False) for p in chosen),
-                "largest_component": components(names, chosen)}
+                "largest_component": max(component_sizes(names, chosen), default=0)}
     sweep = {}
     for method, readme in [("yan", YAN_README), ("cui", CUI_README)]:
         s = np.load(os.path.join(out, f"{method}.npy"))
