@@ -16,7 +16,7 @@ usage:
       COLMAP 4.2's `calibrate_view_graph` (the `view_graph_calibrator` command) on a copy of DB:
       the pairs it leaves valid, OUT/keep/calibrator.txt.
   disambiguation_peers.py table WORK SCENE...      (any python 3)
-      one Markdown table of WORK/SCENE/measure/results.json (lab-measure.py's).
+      one Markdown table of every run lab-measure.py has finished in WORK/SCENE/measure.
 
 Settings: the checkout's README and its notebooks for the small yan2017 scenes. Yan: track
 degree 3, coverage 0.9, alpha 0.1, at least 5 shared unique tracks, pairs kept at a score >= 0.3
@@ -174,6 +174,8 @@ METHODS = {"full": "full database", "disambiguation": "`--preset disambiguation`
 
 
 def verdict(run, truth):
+    if run["models"] == 0:
+        return "no model"
     judged = run["images"] - len(truth["uncertain"])
     cell = f"{run['correct_agreed']}/{judged}"
     whole = run["models"] == 1 and run["registered"] == run["images"]
@@ -190,20 +192,27 @@ def table(work, scenes):
           "| COLMAP 4.2 global |")
     print("|---|---|---|---|---|---|---|---|---|")
     for scene in scenes:
-        path = os.path.join(work, scene, "measure", "results.json")
-        if not os.path.exists(path):
+        measure = os.path.join(work, scene, "measure")
+        if not os.path.exists(os.path.join(measure, "truth.json")):
             continue
-        r = json.load(open(path))
+        truth = json.load(open(os.path.join(measure, "truth.json")))
         rows = {}
-        for run in r["runs"]:
-            rows.setdefault((run["variant"], run["preset"]), {})[run["mapper"]] = run
-        for (variant, preset), by_mapper in rows.items():
+        for name in os.listdir(measure):
+            if name.startswith("run_") and name.endswith(".json"):
+                run = json.load(open(os.path.join(measure, name)))
+                if run["prune_args"] or run["order"] != "image_id":
+                    continue  # lab-measure.py runs of other options in the same folder
+                rows.setdefault((run["variant"], run["preset"]), {})[run["mapper"]] = run
+        order = list(METHODS)
+        for (variant, preset), by_mapper in sorted(
+                rows.items(), key=lambda kv: (kv[0][0] != "order", kv[0][0],
+                                              order.index(kv[0][1]) if kv[0][1] in order else 99)):
             any_run = next(iter(by_mapper.values()))
             threshold = ""
             sweep = os.path.join(work, scene, f"peers_{variant}", "sweep.json")
             if preset.endswith("-best") and os.path.exists(sweep):
                 threshold = f"{json.load(open(sweep))[preset[5:8]]['best']:.2f}"
-            cells = [verdict(by_mapper[m], r["truth"]) if m in by_mapper else "not run"
+            cells = [verdict(by_mapper[m], truth) if m in by_mapper else "not run"
                      for m in ("colmap3.8", "global")]
             print(f"| {scene} | {'capture' if variant == 'order' else variant} "
                   f"| {METHODS.get(preset, preset)} | {threshold} | {any_run['pairs_selected']} "
