@@ -5,6 +5,7 @@ make a database: a copy in which exactly chosen pairs stay valid (through `prune
 Standard library only, so that the system python runs it.
 """
 import contextlib
+import csv
 import os
 import re
 import subprocess
@@ -61,6 +62,31 @@ def only_pairs(db, out, keep, work, tag):
                     out, "--overwrite", "--keep_pairs", os.path.join(work, f"keep_{tag}.txt"),
                     "--forbid_pairs", os.path.join(work, f"forbid_{tag}.txt")],
                    check=True, capture_output=True)
+
+
+def pair_labels(path):
+    """{(image_id1, image_id2): true?} of a `vgsel-colmap eval --labels` CSV."""
+    with open(path) as f:
+        return {(int(r["image_id1"]), int(r["image_id2"])): r["true_pair"] == "1"
+                for r in csv.DictReader(f)}
+
+
+def component_sizes(nodes, pairs):
+    """Sizes of the connected components of the graph of `nodes` under `pairs`."""
+    parent = {n: n for n in nodes}
+
+    def find(n):
+        while parent[n] != n:
+            parent[n] = parent[parent[n]]
+            n = parent[n]
+        return n
+
+    for a, b in pairs:
+        parent[find(a)] = find(b)
+    sizes = {}
+    for n in nodes:
+        sizes[find(n)] = sizes.get(find(n), 0) + 1
+    return list(sizes.values())
 
 
 def camera_centre(qw, qx, qy, qz, tx, ty, tz):

@@ -2,7 +2,7 @@
 """Measurements on a lab photo set without published ground truth (docs/priors.md).
 
 usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--orbit] [--window W]
-           [--run PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]] ...]
+           [--ground_truth MODEL] [--run PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]] ...]
 
   NAME      the set's name in the output
   IMAGES    its image folder (file names sort in capture order; for the stretched yan2017 frames
@@ -13,11 +13,15 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
   --orbit   the capture is a closed orbit (Cup): the sanity check asks the orbit to close
   --window  the sequential graph's reach in frames [3]; more bridges the jumps of a capture that
             is only roughly a sequence (Oats, Cereal), at the risk of a false pair in it
+  --ground_truth  a real ground truth (text model, e.g. a rendered scene's gt/): used as the
+            reference instead of step 1's pseudo ground truth (trusted, nothing uncertain)
   --run     a prune + mapper run to score, PRESET:VARIANT[:ORDER[:MAPPER[:PRUNE_ARGS]]], e.g.
             paper-disambiguation:order, disambiguation:order:image_id:global or
             "disambiguation:order:name:global:--sequence_window 3 --keep_neighbours 3"
             (PRESET `full`: the database unpruned; `truth`: exactly the pairs the reference
-            labels true, the best a selection can hand that mapper; --order, default image_id; mapper colmap3.8
+            labels true, the best a selection can hand that mapper; `keep=FILE`: exactly the
+            verified pairs FILE lists, one `NAME1 NAME2` a line, e.g. another method's
+            selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).
 
@@ -65,20 +69,22 @@ def log(msg):
     print(f"lab-measure: {msg}", file=sys.stderr, flush=True)
 
 
-def run(cmd, logfile=None):
+def run(cmd, logfile=None, outcome=None):
+    """stdout of cmd; stops on a failure unless its output says `outcome` (an expected result,
+    such as COLMAP 3.8's mapper finding no initial pair)."""
     out = subprocess.run(["nice", "-n", "5", *cmd], capture_output=True, text=True)
     if logfile:
         with open(logfile, "w") as f:
             f.write(out.stdout + out.stderr)
-    if out.returncode != 0:
+    if out.returncode != 0 and not (outcome and outcome in out.stdout + out.stderr):
         sys.exit(f"lab-measure: failed: {' '.join(cmd)}\n{out.stderr[-2000:]}")
     return out.stdout
 
 
 def mapper(db, images, out):
-    """`colmap mapper` into out/ (sub-models out/0, out/1, ...), on a copy of db (COLMAP 3.8
-    bumps the SQLite change counter of a database it maps, which would make check_inputs refuse
-    the next run), unless done before."""
+    """`colmap mapper` into out/ (sub-models out/0, out/1, ...; none when it finds no initial
+    pair), on a copy of db (COLMAP 3.8 bumps the SQLite change counter of a database it maps,
+    which would make check_inputs refuse the next run), unless done before."""
     if os.path.exists(out + ".done"):
         return
     shutil.rmtree(out, ignore_errors=True)
@@ -87,7 +93,8 @@ def mapper(db, images, out):
     shutil.copyfile(db, copy)
     log(f"colmap mapper {db}")
     run(["colmap", "mapper", "--database_path", copy, "--image_path", images, "--output_path",
-         out, "--Mapper.extract_colors", "0"], out + ".log")
+         out, "--Mapper.extract_colors", "0"], out + ".log",
+        outcome="failed to create sparse model")
     os.remove(copy)
     open(out + ".done", "w").close()
 
@@ -143,10 +150,24 @@ def complete(sparse, total):
     return json.loads(run([VGSEL, "eval", "--model", sparse]))["registered"] == total
 
 
-def truth(images, order_db, work, orbit):
+def given_truth(model, work):
+    """A real ground truth as the reference: copied to WORK/truth_txt, nothing uncertain."""
+    txt = os.path.join(work, "truth_txt")
+    shutil.rmtree(txt, ignore_errors=True)
+    shutil.copytree(model, txt)
+    registered = len(read_images(txt))
+    return {"source": "given", "models": 1, "registered": registered, "images": registered,
+            "trusted": True, "uncertain": []}
+
+
+def truth(images, order_db, work, orbit, given=None):
     path = os.path.join(work, "truth.json")
     if os.path.exists(path):
         return json.load(open(path))
+    if given:
+        result = given_truth(given, work)
+        json.dump(result, open(path, "w"), indent=1)
+        return result
     seq_db = os.path.join(work, "sequential.db")
     if not os.path.exists(seq_db):
         sequential_copy(order_db, seq_db, work)
@@ -236,12 +257,32 @@ def aucs(db, work, variant):
     return out
 
 
+def listed_pairs(db, work, variant, path, tag):
+    """A copy of db in which exactly the verified pairs listed in `path` (`NAME1 NAME2` lines)
+    stay valid."""
+    out = os.path.join(work, f"pruned_{tag}.db")
+    if os.path.exists(out):
+        return out
+    names, _ = view_graph(db)
+    ids = {name: i for i, name in names.items()}
+    listed = set()
+    for line in open(path):
+        a, b = line.split()
+        if a in ids and b in ids:
+            listed.add(tuple(sorted((ids[a], ids[b]))))
+    only_pairs(db, out, lambda rank, a, b: tuple(sorted((a, b))) in listed, work, tag)
+    return out
+
+
 def scored_run(images, work, dbs, spec):
     preset, variant, *rest = spec.split(":", 4)
     order = rest[0] if rest else "image_id"
     kind = rest[1] if len(rest) > 1 else "colmap3.8"
     extra = rest[2].split() if len(rest) > 2 else []
-    tag = f"{preset}_{variant}_{order}" + ("_global" if kind == "global" else "")
+    listed = preset[len("keep="):] if preset.startswith("keep=") else None
+    if listed:
+        preset = "keep=" + os.path.splitext(os.path.basename(listed))[0]
+    tag = f"{preset.replace('=', '_')}_{variant}_{order}" + ("_global" if kind == "global" else "")
     if extra:
         tag += "_" + hashlib.sha1(" ".join(extra).encode()).hexdigest()[:8]
     path = os.path.join(work, f"run_{tag}.json")
@@ -252,6 +293,8 @@ def scored_run(images, work, dbs, spec):
         pruned, r = db, None
     elif preset == "truth":
         pruned, r = true_pairs_only(db, work, variant, tag), None
+    elif listed:
+        pruned, r = listed_pairs(db, work, variant, listed, tag), None
     else:
         pruned = os.path.join(work, f"pruned_{tag}.db")
         report = os.path.join(work, f"prune_{tag}.json")
@@ -262,8 +305,12 @@ def scored_run(images, work, dbs, spec):
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
     txt = os.path.join(work, "truth_txt")
-    e = json.loads(run([VGSEL, "eval", "--model", sparse, "--ground_truth", txt,
+    model = any(d.isdigit() for d in os.listdir(sparse)) if os.path.isdir(sparse) else False
+    # No model: the pairs are still counted (the reference stands in for the model).
+    e = json.loads(run([VGSEL, "eval", "--model", sparse if model else txt, "--ground_truth", txt,
                         "--database_path", pruned, "--baseline", db]))
+    if not model:
+        e.update(models=0, registered=0, correct=0, images=[])
     uncertain = set(json.load(open(os.path.join(work, "truth.json")))["uncertain"])
     agreed = [i for i in e["images"] if i["name"] not in uncertain]
     result = {"preset": preset, "variant": variant, "order": order, "mapper": kind,
@@ -275,7 +322,8 @@ def scored_run(images, work, dbs, spec):
               "models": e["models"], "registered": e["registered"], "correct": e["correct"],
               "correct_agreed": sum(i["correct"] for i in agreed),
               "images": e["images_ground_truth"], "false_kept": e["pairs"]["false"],
-              "false_total": e["pairs"]["baseline"]["false"]}
+              "false_total": e["pairs"]["baseline"]["false"], "true_kept": e["pairs"]["true"],
+              "true_total": e["pairs"]["baseline"]["true"]}
     json.dump(result, open(path, "w"), indent=1)
     return result
 
@@ -318,6 +366,11 @@ def main(argv):
         k = argv.index("--window")
         WINDOW = int(argv[k + 1])
         del argv[k:k + 2]
+    given = None
+    if "--ground_truth" in argv:
+        k = argv.index("--ground_truth")
+        given = argv[k + 1]
+        del argv[k:k + 2]
     runs = [argv[k + 1] for k, a in enumerate(argv) if a == "--run"]
     argv = [a for k, a in enumerate(argv) if a != "--run" and (k == 0 or argv[k - 1] != "--run")]
     if len(argv) < 4:
@@ -326,7 +379,7 @@ def main(argv):
     os.makedirs(work, exist_ok=True)
     dbs = {"order": order_db, **dict(m.split("=", 1) for m in more)}
     check_inputs(work, images, dbs, orbit)
-    result = {"set": name, "truth": truth(images, order_db, work, orbit)}
+    result = {"set": name, "truth": truth(images, order_db, work, orbit, given)}
     result["auc"] = {v: aucs(db, work, v) for v, db in dbs.items()}
     result["runs"] = [scored_run(images, work, dbs, spec) for spec in runs]
     json.dump(result, open(os.path.join(work, "results.json"), "w"), indent=1)

@@ -21,31 +21,7 @@ import subprocess
 import sys
 import tempfile
 
-from colmap_files import VGSEL, view_graph
-
-
-def labels(path):
-    out = {}
-    with open(path) as f:
-        next(f)
-        for line in f:
-            a, b, _, t = line.strip().split(",")
-            out[(int(a), int(b))] = t == "1"
-    return out
-
-
-def components(images, edges):
-    parent = {i: i for i in images}
-
-    def find(x):
-        while parent[x] != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
-    for a, b in edges:
-        parent[find(a)] = find(b)
-    return len({find(i) for i in images})
+from colmap_files import VGSEL, component_sizes, pair_labels, view_graph
 
 
 @functools.lru_cache(maxsize=None)
@@ -67,7 +43,7 @@ def outcome(db, lab, args, tmp):
     true = [p for p in kept if lab.get(p)]
     false = sum(1 for p in kept if lab.get(p) is False)
     # An image without a verified pair is a component of its own.
-    return f"{false}/{len(true)}/{components(ids.values(), true) + isolated}"
+    return f"{false}/{len(true)}/{len(component_sizes(ids.values(), true)) + isolated}"
 
 
 def main(argv):
@@ -83,7 +59,7 @@ def main(argv):
             cells = []
             for _, spec in sets:
                 db, lab = spec.split(":")
-                cells.append(outcome(db, labels(lab), shlex.split(args), tmp))
+                cells.append(outcome(db, pair_labels(lab), shlex.split(args), tmp))
             print(v.ljust(12), " ".join(c.rjust(12) for c in cells), flush=True)
     print("cells: false pairs kept / true pairs kept / components of the kept true pairs")
 
