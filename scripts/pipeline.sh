@@ -16,6 +16,9 @@
 #   CAMERA_MODEL    [SIMPLE_RADIAL]              CAMERA_PARAMS known intrinsics, e.g. "f,cx,cy" []
 #   SINGLE_CAMERA   one camera for all images [1]
 #   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
+#   REPAIR          1: the repair loop (docs/check.md): `vgsel-colmap check` on the pruned
+#                   model, and where it says ghosted, `prune --model` on it and one more mapper
+#                   run, a third row `repaired` [0]
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -66,8 +69,9 @@ log "prune $prune_args"
 # The pruned database was just rewritten, so its reconstruction is redone.
 rm -f "$work/sparse_pruned.seconds"
 
-for variant in full pruned; do
-  sparse=$work/sparse_$variant
+# The mapper on one database of WORKDIR (full, pruned or repaired) and the eval of its model.
+map_and_eval() {
+  local variant=$1 sparse=$work/sparse_$1
   if [ ! -f "$sparse.seconds" ]; then
     rm -rf "$sparse"
     mkdir -p "$sparse"
@@ -77,16 +81,36 @@ for variant in full pruned; do
   fi
   eval_args=(--model "$sparse" --database_path "$work/$variant.db")
   [ -n "$gt" ] && eval_args+=(--ground_truth "$gt")
-  [ "$variant" = pruned ] && eval_args+=(--baseline "$work/full.db")
+  [ "$variant" != full ] && eval_args+=(--baseline "$work/full.db")
   "$bin" eval "${eval_args[@]}" >"$work/eval_$variant.json"
-done
+}
+map_and_eval full
+map_and_eval pruned
+rm -f "$work/eval_repaired.json" "$work/sparse_repaired.seconds"
+if [ "${REPAIR:-0}" = 1 ]; then
+  status=0
+  "$bin" check --model "$work/sparse_pruned" --database_path "$work/pruned.db" \
+    --report "$work/check_pruned.json" >&2 || status=$?
+  if [ "$status" = 3 ]; then
+    log "the pruned model is ghosted: prune --model, mapper again"
+    # shellcheck disable=SC2086
+    "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired.db" --overwrite \
+      --report "$work/prune_repaired.json" --model "$work/sparse_pruned" $prune_args
+    map_and_eval repaired
+  elif [ "$status" != 0 ]; then
+    exit "$status"
+  fi
+fi
 
 python3 - "$work" "$t_extract" "$t_match" <<'EOF'
 import json, sys
 work, t_extract, t_match = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
 rows = {}
-for v in ("full", "pruned"):
-    e = json.load(open(f"{work}/eval_{v}.json"))
+for v in ("full", "pruned", "repaired"):
+    try:
+        e = json.load(open(f"{work}/eval_{v}.json"))
+    except FileNotFoundError:
+        continue
     e["mapper_seconds"] = float(open(f"{work}/sparse_{v}.seconds").read())
     rows[v] = e
 fmt = lambda x, f: "-" if x is None else f % x

@@ -276,5 +276,29 @@ fn describe(
     }
 }
 
+/// The repair's evidence (`prune --model DIR`): in each model of `dir` (a model folder or a
+/// mapper's output_path) that the check finds ghosted, the pairs of images across its worst
+/// split that share 3D points: the pairs whose matches glued one copy onto the other. Pairs
+/// across the split that share no point are not blamed: in a ghosted model they are mostly the
+/// true links the mapper could not use (measured on the demo scene: docs/check.md). Name pairs,
+/// sorted; empty when no model is ghosted.
+pub fn conflicting_pairs(
+    dir: &std::path::Path,
+    settings: &CheckSettings,
+) -> Result<Vec<[String; 2]>> {
+    let mut blamed = std::collections::BTreeSet::new();
+    for model_dir in crate::colmap::model::model_dirs(dir)? {
+        let model = crate::colmap::sparse::read_sparse_model(&model_dir)?;
+        let checked = check_model(&model, None, settings)?;
+        let Some(worst) = checked.worst.filter(|_| checked.ghosted) else {
+            continue;
+        };
+        for p in worst.joining_pairs.iter().filter(|p| p.shared_points > 0) {
+            blamed.insert([p.image1.clone(), p.image2.clone()]);
+        }
+    }
+    Ok(blamed.into_iter().collect())
+}
+
 #[cfg(test)]
 mod tests;

@@ -59,6 +59,11 @@ pub struct PruneArgs {
     /// Never select these images nor any of their pairs (one name a line).
     #[arg(long, value_name = "FILE", help_heading = SELECT)]
     forbid_images: Option<PathBuf>,
+    /// A mapper's output on this database (a model folder or its output_path), for the repair
+    /// loop: the pairs that glued a model `check` finds ghosted are never selected
+    /// (docs/check.md).
+    #[arg(long, value_name = "DIR", help_heading = SELECT)]
+    model: Option<PathBuf>,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
     #[arg(long, default_value_t = DEFAULT_MIN_NUM_MATCHES, help_heading = SELECT)]
     min_num_matches: usize,
@@ -139,6 +144,7 @@ impl PruneArgs {
             keep_pairs: self.keep_pairs.clone(),
             forbid_pairs: self.forbid_pairs.clone(),
             forbid_images: self.forbid_images.clone(),
+            model: self.model.clone(),
             ..self.flow.given()
         }
     }

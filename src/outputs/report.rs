@@ -253,6 +253,12 @@ impl Report {
                 o.forbid_images.len()
             );
         }
+        if let Some(blamed) = &o.model_conflicts {
+            s += &format!(
+                "\nmodel check: {} pairs that glued a ghosted model never selected",
+                blamed.len()
+            );
+        }
         if self.order.keep_neighbours > 0 {
             s += &format!(
                 "\nclose neighbours: {} pairs within {} positions kept",

@@ -1,8 +1,10 @@
 //! The arc rules: which pair arcs of the paper's network are fixed (kept whatever the flow
-//! selects) or removed before the flow runs, besides the costs. Three sources, applied in this
-//! order: the user's overrides (`--keep_pairs`, `--forbid_pairs`, `--forbid_images`), close
-//! neighbours in a capture sequence (`--keep_neighbours`), and the fitness floor
-//! (`--min_pair_fitness`, lowered as far as the search needs).
+//! selects) or removed before the flow runs, besides the costs. Four sources, applied in this
+//! order: the user's overrides (`--keep_pairs`, `--forbid_pairs`, `--forbid_images`), the
+//! pairs a model check blames (`--model`: the pairs that glued a ghosted model's copies, see
+//! [`crate::check::conflicting_pairs`]), close neighbours in a capture sequence
+//! (`--keep_neighbours`), and the fitness floor (`--min_pair_fitness`, lowered as far as the
+//! search needs).
 //!
 //! Rules change the network ([`crate::flow::network::SelectionProblem::restrict`]), never
 //! the costs, so the result stays an exact min-cost flow and is easy to explain:
@@ -39,6 +41,9 @@ pub struct ArcRules {
     pub forbid_pairs: Option<PathBuf>,
     /// `--forbid_images`: the file of images never selected.
     pub forbid_images: Option<PathBuf>,
+    /// `--model`: a mapper's output on this database; the pairs that glued a model the check
+    /// finds ghosted are never selected.
+    pub model: Option<PathBuf>,
 }
 
 /// One list file as read: each entry with its 1-based line number.
@@ -93,6 +98,9 @@ pub struct Overrides {
     pub forbid_pairs: Option<NameList>,
     /// `--forbid_images`: images taken out of the network with all their pairs.
     pub forbid_images: Option<NameList>,
+    /// `--model`: the pairs the model check blames, never selected (a pair list whose path is
+    /// the model folder).
+    pub model_conflicts: Option<NameList>,
 }
 
 /// The overrides as listed in the report, by image name.
@@ -108,6 +116,9 @@ pub struct Listed {
     pub forbid_images: Vec<String>,
     /// Pairs taken out of the network because one of their images is forbidden.
     pub pairs_of_forbidden_images: usize,
+    /// Pairs the model check blamed (`--model`), never selected; absent without `--model`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_conflicts: Option<Vec<[String; 2]>>,
 }
 
 /// Overrides resolved against a view graph.
@@ -142,6 +153,9 @@ impl Overrides {
         }
         if let Some(list) = &self.forbid_pairs {
             resolved.forbid_pairs(list, &names)?;
+        }
+        if let Some(list) = &self.model_conflicts {
+            resolved.forbid_model_conflicts(list, &names)?;
         }
         if let Some(list) = &self.keep_pairs {
             resolved.keep_pairs(list, &names, min_num_matches)?;
@@ -236,6 +250,19 @@ impl Resolved {
                 .forbid_pairs
                 .push([entry[0].clone(), entry[1].clone()]);
         }
+        Ok(())
+    }
+
+    /// `--model`: the pairs the model check blames leave the network (those that are edges).
+    fn forbid_model_conflicts(&mut self, list: &NameList, names: &Names) -> Result<()> {
+        let mut blamed = Vec::new();
+        for (line, entry) in &list.entries {
+            if let Some(k) = names.edge(list, *line, entry)? {
+                self.edges[k] = ArcRule::Removed;
+            }
+            blamed.push([entry[0].clone(), entry[1].clone()]);
+        }
+        self.listed.model_conflicts = Some(blamed);
         Ok(())
     }
 
@@ -340,6 +367,37 @@ mod tests {
     use crate::colmap::database::VerifiedPair;
     use crate::flow::search::Criteria;
     use crate::scene::testing::{images, pair};
+
+    /// The model check's pairs leave the network like forbidden pairs, and are listed; a
+    /// blamed pair that is no view-graph edge is listed and changes nothing.
+    #[test]
+    fn pairs_the_model_check_blames_are_never_selected() {
+        let images = images(4);
+        let pairs: Vec<VerifiedPair> = (1..4).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let name = |id: u32| images[id as usize - 1].name.clone();
+        let list = NameList {
+            path: PathBuf::from("sparse"),
+            entries: vec![(1, vec![name(2), name(3)]), (2, vec![name(1), name(4)])],
+        };
+        let overrides = Overrides {
+            model_conflicts: Some(list),
+            ..Overrides::default()
+        };
+        let resolved = overrides.resolve(&images, &graph, 15).unwrap();
+        assert_eq!(
+            resolved.edges,
+            [ArcRule::Free, ArcRule::Removed, ArcRule::Free]
+        );
+        let listed = resolved.listed.model_conflicts.unwrap();
+        assert_eq!(listed, [[name(2), name(3)], [name(1), name(4)]]);
+        assert!(Overrides::default()
+            .resolve(&images, &graph, 15)
+            .unwrap()
+            .listed
+            .model_conflicts
+            .is_none());
+    }
 
     #[test]
     fn the_floor_is_lowered_only_as_far_as_the_criteria_need() {

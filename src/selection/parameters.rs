@@ -6,6 +6,7 @@
 //! in the database's run record (`vgsel_runs.parameters`, [`crate::colmap::rewrite::RunRecord`])
 //! and `export` reads it back to recompute the very costs that drove the selection.
 
+use crate::check;
 use crate::costs::CostModel;
 use crate::flow::search::{Criteria, FlowRule, GivenCriteria};
 use crate::named::Named;
@@ -14,7 +15,7 @@ use crate::selection::arc_rules::{ArcRules, NameList, Overrides};
 use crate::selection::capture_order::{self, Order};
 use crate::selection::preset::Preset;
 use crate::selection::track_completion::Needs;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -58,6 +59,8 @@ pub struct Given {
     pub forbid_pairs: Option<PathBuf>,
     /// `--forbid_images`.
     pub forbid_images: Option<PathBuf>,
+    /// `--model`.
+    pub model: Option<PathBuf>,
 }
 
 /// Everything that decides a selection, besides the database.
@@ -165,6 +168,7 @@ impl Parameters {
                 keep_pairs: given.keep_pairs,
                 forbid_pairs: given.forbid_pairs,
                 forbid_images: given.forbid_images,
+                model: given.model,
             },
         })
     }
@@ -178,7 +182,8 @@ impl Parameters {
         Parameters::resolve(given).expect("a preset's own parameters resolve")
     }
 
-    /// The override files named in `arc_rules`, read.
+    /// The override files named in `arc_rules`, read, and the pairs the model check blames in
+    /// `--model`'s models.
     pub fn read_overrides(&self) -> Result<Overrides> {
         let read = |path: &Option<PathBuf>, pairs| {
             path.as_deref()
@@ -186,10 +191,21 @@ impl Parameters {
                 .transpose()
         };
         let rules = &self.arc_rules;
+        let model_conflicts = rules.model.as_deref().map(|dir| {
+            let pairs = check::conflicting_pairs(dir, &check::DEFAULT_SETTINGS)
+                .with_context(|| format!("checking --model {}", dir.display()))?;
+            let entries = pairs.into_iter().enumerate();
+            let entries = entries.map(|(k, [a, b])| (k + 1, vec![a, b])).collect();
+            anyhow::Ok(NameList {
+                path: dir.to_path_buf(),
+                entries,
+            })
+        });
         Ok(Overrides {
             keep_pairs: read(&rules.keep_pairs, true)?,
             forbid_pairs: read(&rules.forbid_pairs, true)?,
             forbid_images: read(&rules.forbid_images, false)?,
+            model_conflicts: model_conflicts.transpose()?,
         })
     }
 }
@@ -228,6 +244,8 @@ struct Recorded {
     keep_pairs: Option<String>,
     forbid_pairs: Option<String>,
     forbid_images: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    model: Option<String>,
 }
 
 impl From<Parameters> for Recorded {
@@ -260,6 +278,7 @@ impl From<Parameters> for Recorded {
             keep_pairs: text(p.arc_rules.keep_pairs),
             forbid_pairs: text(p.arc_rules.forbid_pairs),
             forbid_images: text(p.arc_rules.forbid_images),
+            model: text(p.arc_rules.model),
         }
     }
 }
@@ -299,6 +318,7 @@ impl From<Recorded> for Parameters {
                 keep_pairs: r.keep_pairs.map(PathBuf::from),
                 forbid_pairs: r.forbid_pairs.map(PathBuf::from),
                 forbid_images: r.forbid_images.map(PathBuf::from),
+                model: r.model.map(PathBuf::from),
             },
         }
     }
