@@ -2,8 +2,8 @@
 """The bounds of the rendered designs: what the mapper makes of the database with exactly the true
 pairs, against the full database and `--preset disambiguation` (docs/results.md).
 
-For each design (DESIGN:IMAGES:SEED; by default duplicate:20:1 twin:36:1 twin:36:2 symmetric:24:1
-street:20:1): render it (`generate images`), match it with COLMAP 3.8 (1024 SIFT, exhaustive, the
+For each design (DESIGN:IMAGES:SEED; by default duplicate:20, twin:36, symmetric:24 and street:20,
+each with seeds 1 and 2): render it (`generate images`), match it with COLMAP 3.8 (1024 SIFT, exhaustive, the
 rendering camera's intrinsics given), label its pairs with `eval --labels` (exact: the ground truth
 holds the renderer's scene.json) and, for comparison, with the epipolar labels (the same ground
 truth without scene.json), and map four databases: the full one, the disambiguation preset's, the
@@ -29,7 +29,8 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 from colmap_files import VGSEL, only_pairs, view_graph  # noqa: E402
 
-DESIGNS = ["duplicate:20:1", "twin:36:1", "twin:36:2", "symmetric:24:1", "street:20:1"]
+DESIGNS = [f"{design}:{seed}" for design in ("duplicate:20", "twin:36", "symmetric:24", "street:20")
+           for seed in (1, 2)]
 CAMERA_PARAMS = "400,240,180,0"  # render.rs: FOCAL, WIDTH / 2, HEIGHT / 2, k = 0
 DATABASES = ["full", "disambiguation", "truth", "epipolar truth"]
 

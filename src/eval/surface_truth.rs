@@ -15,8 +15,8 @@ use crate::eval::render::Scene;
 use nalgebra::Vector3;
 
 /// A pair is true when the median transfer error of its inliers is below this many pixels.
-/// Measured on the five rendered databases of docs/results.md (`scripts/lab/bounds.py`: the
-/// duplicate, twin (two seeds), symmetric and street designs matched by COLMAP 3.8, 1024 SIFT):
+/// Measured on the eight rendered databases of docs/results.md (`scripts/lab/bounds.py`: the
+/// duplicate, twin, symmetric and street designs, seeds 1 and 2, matched by COLMAP 3.8):
 /// true pairs have medians of 0.1–1.4 px (typically 0.2–0.3: SIFT's localisation on
 /// 2x2-supersampled images), false ones 80 px and more (a copy is metres away) or infinite.
 /// 2 px is above every true pair measured and 40 times below the nearest false one.
