@@ -32,6 +32,9 @@ pub struct CheckSettings {
     /// Conflicting samples a split needs at least to be called two copies (few samples say
     /// little).
     pub min_conflicts: usize,
+    /// Agreeing samples every split is credited with before counting: the score is
+    /// conflicting / (judged + prior), so a ratio over few samples counts for less.
+    pub prior: usize,
 }
 
 /// The defaults, the one setting of docs/check.md's measurements.
@@ -44,6 +47,7 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     min_group: 3,
     threshold: 0.4,
     min_conflicts: 30,
+    prior: 500,
 };
 
 /// A database pair (verified, not invalidated by a prune) between the two groups.
@@ -68,6 +72,8 @@ pub struct Split {
     pub counts: Counts,
     /// Conflict ratio: conflicting over judged samples.
     pub ratio: f64,
+    /// The score: conflicting over judged samples plus [`CheckSettings::prior`].
+    pub score: f64,
     /// Database pairs between the groups, most inliers first (model links where the check ran
     /// without a database).
     pub joining_pairs: Vec<JoiningPair>,
@@ -136,7 +142,7 @@ pub fn check_model(
     let candidates = candidates(&views, &covisibility, settings);
     // The worst split: the highest ratio among those with enough conflicts to be judged, else
     // the highest ratio (reported, never ghosted).
-    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, c.ratio());
+    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, score(c, settings));
     let mut worst: Option<(Vec<bool>, Counts)> = None;
     for side in &candidates {
         let counts = conflict::count(&views, side, &settings.conflict);
@@ -146,14 +152,15 @@ pub fn check_model(
     }
     let (side, split) = match worst {
         Some((side, counts)) => {
-            let split = describe(&views, &covisibility, &side, counts, pairs);
+            let mut split = describe(&views, &covisibility, &side, counts, pairs);
+            split.score = score(&counts, settings);
             (side, Some(split))
         }
         None => (vec![false; n], None),
     };
-    let score = split.as_ref().map_or(0.0, |s| s.ratio);
+    let score = split.as_ref().map_or(0.0, |s| s.score);
     let ghosted = split.as_ref().is_some_and(|s| {
-        s.ratio >= settings.threshold && s.counts.conflicting >= settings.min_conflicts
+        s.score >= settings.threshold && s.counts.conflicting >= settings.min_conflicts
     });
     Ok(ModelCheck {
         images: n,
@@ -165,6 +172,11 @@ pub fn check_model(
         side,
         views: Some(views),
     })
+}
+
+/// A split's score: conflicting over judged samples plus the prior.
+fn score(c: &Counts, settings: &CheckSettings) -> f64 {
+    c.conflicting as f64 / (c.conflicting + c.agreeing + settings.prior).max(1) as f64
 }
 
 /// A link between two images agrees when at least this many samples were judged...
@@ -272,6 +284,8 @@ fn describe(
         groups: [names(false), names(true)],
         counts,
         ratio: counts.ratio(),
+        // Set by the caller, which knows the prior.
+        score: 0.0,
         joining_pairs: joining,
     }
 }
