@@ -1,11 +1,12 @@
 //! The model check: is a reconstruction ghosted (two copies of repeated structure registered
 //! onto each other), and where? Without ground truth, from the model and its database alone.
 //!
-//! Every image of a model is a view ([`views`]); the co-visibility graph's maximum spanning tree
-//! offers candidate splits into two groups ([`splits`]); each split is scored by conflicting
-//! observations ([`conflict`]); a model whose worst split's conflict ratio reaches the
-//! threshold is ghosted, and the report names the two groups and the database pairs that join
-//! them. docs/check.md gives the method, what it assumes and its measurements.
+//! Every image of a model is a view ([`views`]); the co-visibility graph and the links that
+//! agree offer candidate splits into two groups ([`splits`]); each split is scored by
+//! conflicting observations ([`conflict`]); a model whose worst split's score (its conflict
+//! ratio, with a prior of agreeing samples) reaches the threshold is ghosted, and the report
+//! names the two groups and the database pairs that join them. docs/check.md gives the method,
+//! what it assumes and its measurements.
 
 pub mod conflict;
 pub mod plot;
@@ -63,7 +64,7 @@ pub struct JoiningPair {
     pub shared_points: usize,
 }
 
-/// The split with the highest conflict ratio.
+/// The split with the highest score.
 #[derive(Clone, Debug, Serialize)]
 pub struct Split {
     /// The two groups' image names (the first holds the model's first image).
@@ -90,7 +91,7 @@ pub struct ModelCheck {
     pub splits_scored: usize,
     /// The verdict: the worst split reaches the threshold with enough conflicts.
     pub ghosted: bool,
-    /// The worst split's conflict ratio (0 without a split).
+    /// The worst split's score (0 without a split).
     pub score: f64,
     /// The worst split, if the model could be split at all.
     pub worst: Option<Split>,
@@ -140,8 +141,8 @@ pub fn check_model(
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
     let candidates = candidates(&views, &covisibility, settings);
-    // The worst split: the highest ratio among those with enough conflicts to be judged, else
-    // the highest ratio (reported, never ghosted).
+    // The worst split: the highest score among those with enough conflicts to be judged, else
+    // the highest score (reported, never ghosted).
     let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, score(c, settings));
     let mut worst: Option<(Vec<bool>, Counts)> = None;
     for side in &candidates {
