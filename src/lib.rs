@@ -4,7 +4,8 @@
 //! [`geometry`] and [`priors`] measure images and pairs, [`costs`] turn measurements into arc
 //! costs, [`flow`] finds the min-cost flow of the paper (Shah, Chari, Narayanan) and the flow F,
 //! [`selection`] runs that pipeline, [`colmap::rewrite`] invalidates the unselected pairs,
-//! reversibly, and [`outputs`] describe what was done. [`eval`] is the evaluation tooling.
+//! reversibly, and [`outputs`] describe what was done. After a mapper run, [`check`] says
+//! whether a model is ghosted, without ground truth. [`eval`] is the evaluation tooling.
 
 #![warn(missing_docs)]
 

@@ -5,7 +5,8 @@ check's (from `check --report`), and the range of --threshold over which every v
 usage: check-table.py ROWS.tsv OUT.json
 ROWS.tsv lines: SCENE <tab> RUN/SUBMODEL <tab> MODEL_DIR (with MODEL_DIR.eval.json and
 MODEL_DIR.check.json next to it).
-Truth: ghosted when at least 2 and at least 20% of the registered images are not correct;
+Truth: ghosted when at least 2 and at least 20% of the registered images are more than 5% of
+the extent from their true centres;
 without ground truth, RUN.truth (topview.py's verdict, written by check-scenes.sh) for
 sub-model 0, else unknown (listed, not counted).
 """
@@ -15,8 +16,15 @@ import sys
 
 
 def truth(e):
-    wrong = e["registered"] - e["correct"]
+    """Ghosted when at least 2 and 20% of the registered images stand elsewhere. By position
+    only: templeRing's ground truth turns 16 cameras by 180 degrees at their right centres, which
+    no reconstruction can match and no ghost explains."""
+    wrong = sum(i["position_error"] >= POSITION_TOLERANCE for i in e["images"])
     return wrong >= 2 and wrong >= 0.2 * e["registered"], wrong
+
+
+# eval's position tolerance: 5% of the ground truth's extent.
+POSITION_TOLERANCE = 0.05
 
 
 def main():

@@ -1,11 +1,12 @@
 //! The model check: is a reconstruction ghosted (two copies of repeated structure registered
 //! onto each other), and where? Without ground truth, from the model and its database alone.
 //!
-//! Every image of a model is a view ([`views`]); the co-visibility graph's maximum spanning tree
-//! offers candidate splits into two groups ([`splits`]); each split is scored by conflicting
-//! observations ([`conflict`]); a model whose worst split's conflict ratio reaches the
-//! threshold is ghosted, and the report names the two groups and the database pairs that join
-//! them. docs/check.md gives the method, what it assumes and its measurements.
+//! Every image of a model is a view ([`views`]); the co-visibility graph and the links that
+//! agree offer candidate splits into two groups ([`splits`]); each split is scored by
+//! conflicting observations ([`conflict`]); a model whose worst split's score (its conflict
+//! ratio, with a prior of agreeing samples) reaches the threshold is ghosted, and the report
+//! names the two groups and the database pairs that join them. docs/check.md gives the method,
+//! what it assumes and its measurements.
 
 pub mod conflict;
 pub mod plot;
@@ -32,6 +33,9 @@ pub struct CheckSettings {
     /// Conflicting samples a split needs at least to be called two copies (few samples say
     /// little).
     pub min_conflicts: usize,
+    /// Agreeing samples every split is credited with before counting: the score is
+    /// conflicting / (judged + prior), so a ratio over few samples counts for less.
+    pub prior: usize,
 }
 
 /// The defaults, the one setting of docs/check.md's measurements.
@@ -44,6 +48,7 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     min_group: 3,
     threshold: 0.4,
     min_conflicts: 30,
+    prior: 500,
 };
 
 /// A database pair (verified, not invalidated by a prune) between the two groups.
@@ -59,7 +64,7 @@ pub struct JoiningPair {
     pub shared_points: usize,
 }
 
-/// The split with the highest conflict ratio.
+/// The split with the highest score.
 #[derive(Clone, Debug, Serialize)]
 pub struct Split {
     /// The two groups' image names (the first holds the model's first image).
@@ -68,6 +73,8 @@ pub struct Split {
     pub counts: Counts,
     /// Conflict ratio: conflicting over judged samples.
     pub ratio: f64,
+    /// The score: conflicting over judged samples plus [`CheckSettings::prior`].
+    pub score: f64,
     /// Database pairs between the groups, most inliers first (model links where the check ran
     /// without a database).
     pub joining_pairs: Vec<JoiningPair>,
@@ -84,7 +91,7 @@ pub struct ModelCheck {
     pub splits_scored: usize,
     /// The verdict: the worst split reaches the threshold with enough conflicts.
     pub ghosted: bool,
-    /// The worst split's conflict ratio (0 without a split).
+    /// The worst split's score (0 without a split).
     pub score: f64,
     /// The worst split, if the model could be split at all.
     pub worst: Option<Split>,
@@ -134,9 +141,9 @@ pub fn check_model(
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
     let candidates = candidates(&views, &covisibility, settings);
-    // The worst split: the highest ratio among those with enough conflicts to be judged, else
-    // the highest ratio (reported, never ghosted).
-    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, c.ratio());
+    // The worst split: the highest score among those with enough conflicts to be judged, else
+    // the highest score (reported, never ghosted).
+    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, score(c, settings));
     let mut worst: Option<(Vec<bool>, Counts)> = None;
     for side in &candidates {
         let counts = conflict::count(&views, side, &settings.conflict);
@@ -146,14 +153,15 @@ pub fn check_model(
     }
     let (side, split) = match worst {
         Some((side, counts)) => {
-            let split = describe(&views, &covisibility, &side, counts, pairs);
+            let mut split = describe(&views, &covisibility, &side, counts, pairs);
+            split.score = score(&counts, settings);
             (side, Some(split))
         }
         None => (vec![false; n], None),
     };
-    let score = split.as_ref().map_or(0.0, |s| s.ratio);
+    let score = split.as_ref().map_or(0.0, |s| s.score);
     let ghosted = split.as_ref().is_some_and(|s| {
-        s.ratio >= settings.threshold && s.counts.conflicting >= settings.min_conflicts
+        s.score >= settings.threshold && s.counts.conflicting >= settings.min_conflicts
     });
     Ok(ModelCheck {
         images: n,
@@ -165,6 +173,11 @@ pub fn check_model(
         side,
         views: Some(views),
     })
+}
+
+/// A split's score: conflicting over judged samples plus the prior.
+fn score(c: &Counts, settings: &CheckSettings) -> f64 {
+    c.conflicting as f64 / (c.conflicting + c.agreeing + settings.prior).max(1) as f64
 }
 
 /// A link between two images agrees when at least this many samples were judged...
@@ -272,6 +285,8 @@ fn describe(
         groups: [names(false), names(true)],
         counts,
         ratio: counts.ratio(),
+        // Set by the caller, which knows the prior.
+        score: 0.0,
         joining_pairs: joining,
     }
 }

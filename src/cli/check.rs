@@ -28,7 +28,7 @@ pub struct CheckArgs {
     /// Write each model's top view (cameras coloured by group) as SVG into DIR.
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
-    /// Conflict ratio from which a model is ghosted.
+    /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = super::args::fraction)]
     threshold: f64,
     /// Expert: largest angle (degrees) between two images' rays for one to be expected to see
@@ -44,6 +44,9 @@ pub struct CheckArgs {
     /// Expert: conflicting samples a ghosted split needs at least.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.min_conflicts)]
     min_conflicts: usize,
+    /// Expert: agreeing samples credited to every split (a ratio over few samples counts less).
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.prior)]
+    prior: usize,
 }
 
 impl CheckArgs {
@@ -54,6 +57,7 @@ impl CheckArgs {
         s.conflict.radius = self.radius;
         s.min_group = self.min_group.max(1);
         s.min_conflicts = self.min_conflicts;
+        s.prior = self.prior;
         s
     }
 }
@@ -61,7 +65,7 @@ impl CheckArgs {
 /// The line a model gets: its verdict, score and groups.
 fn verdict_line(dir: &Path, c: &ModelCheck) -> String {
     let what = if c.ghosted { "GHOSTED" } else { "clean" };
-    let mut line = format!("{}: {what} (conflict ratio {:.2}", dir.display(), c.score);
+    let mut line = format!("{}: {what} (score {:.2}", dir.display(), c.score);
     if let Some(w) = &c.worst {
         line += &format!(
             ", {} conflicting of {} judged; groups of {} and {} images",
@@ -110,7 +114,7 @@ pub fn run(args: &CheckArgs) -> Result<bool> {
             std::fs::create_dir_all(plots)
                 .with_context(|| format!("creating {}", plots.display()))?;
             let title = format!(
-                "{}: {} (conflict ratio {:.2})",
+                "{}: {} (score {:.2})",
                 dir.display(),
                 if result.ghosted { "ghosted" } else { "clean" },
                 result.score

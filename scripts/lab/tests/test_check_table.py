@@ -22,16 +22,23 @@ def write_model(root, run_name, sub, eval_json, score, conflicting, ghosted):
     return f"scene\t{run_name}/{sub}\t{model}\n"
 
 
+def scored(registered, wrong):
+    """eval's report of `registered` images, `wrong` of them 10% of the extent off; one more
+    turned by 180 degrees at its right centre (templeRing's ground truth), which is no ghost."""
+    images = [{"position_error": 0.1 if k < wrong else 0.001} for k in range(registered)]
+    return {"registered": registered, "correct": registered - wrong - 1, "images": images}
+
+
 class CheckTable(unittest.TestCase):
     def test_truths_and_threshold_range(self):
         with tempfile.TemporaryDirectory() as tmp:
             lines = [
                 # 8 of 20 wrong: ghosted by the truth.
-                write_model(tmp, "sparse_full", "0", {"registered": 20, "correct": 12}, 0.76, 700, True),
+                write_model(tmp, "sparse_full", "0", scored(20, 8), 0.76, 700, True),
                 # 1 of 20 wrong: clean.
-                write_model(tmp, "sparse_pruned", "0", {"registered": 20, "correct": 19}, 0.28, 200, False),
+                write_model(tmp, "sparse_pruned", "0", scored(20, 1), 0.28, 200, False),
                 # Too few conflicts: its ratio counts as 0 for the range.
-                write_model(tmp, "global_pruned", "0", {"registered": 20, "correct": 20}, 0.9, 5, False),
+                write_model(tmp, "global_pruned", "0", scored(20, 0), 0.9, 5, False),
                 # No ground truth: topview's verdict for sub-model 0, none for sub-model 1.
                 write_model(tmp, "sparse_x", "0", {"registered": 19}, 0.6, 300, True),
                 write_model(tmp, "sparse_x", "1", {"registered": 4}, 0.1, 0, False),
