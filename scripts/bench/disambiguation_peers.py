@@ -24,8 +24,8 @@ degree 3, coverage 0.9, alpha 0.1, at least 5 shared unique tracks, pairs kept a
 neighbours, squares of radius 20, pairs kept at >= 0.5 (the Street notebook) or the top 3 per
 image. Its filter (scripts/filter_matches.py) keeps a pair when either direction's score passes.
 The sweep (`*-best`) is an oracle that favours the peer: of thresholds 0.00, 0.01, ... 1.00 it
-takes the one whose kept pairs connect the most images, then keep the fewest false pairs, then
-the most true pairs, judged by the same pair labels the table reports.
+takes the one whose kept pairs connect the most images, then keeps the fewest false pairs,
+then the most true pairs, judged by the same pair labels the table reports.
 """
 import json
 import os
