@@ -13,35 +13,26 @@ work=${1:-target/colmap4-mappers}
 runs=${2:-5}
 bin=${VGSEL:-target/release/vgsel-colmap}
 [ -x "$bin" ] || cargo build --release --quiet
-py=$(bash scripts/ci/pycolmap-venv.sh)
+PY=$(bash scripts/ci/pycolmap-venv.sh)
+# shellcheck source=scripts/lab/demo-matching.sh
+source scripts/lab/demo-matching.sh
 rm -rf "$work"
 mkdir -p "$work"
 "$bin" generate images --scene duplicate --num_images 20 --seed 1 --output "$work/scene" -q
 images=$work/scene/images
-params=400,240,180,0
 for run in $(seq 1 "$runs"); do
   for matcher in colmap3.8 pycolmap4.2; do
     dir=$work/$run/$matcher
     mkdir -p "$dir"
     echo "run $run: $matcher matching" >&2
-    if [ "$matcher" = colmap3.8 ]; then
-      nice colmap feature_extractor --database_path "$dir/full.db" --image_path "$images" \
-        --ImageReader.camera_model SIMPLE_RADIAL --ImageReader.single_camera 1 \
-        --ImageReader.camera_params "$params" --SiftExtraction.use_gpu 0 \
-        --SiftExtraction.max_num_features 1024 >"$dir/extract.log" 2>&1
-      nice colmap exhaustive_matcher --database_path "$dir/full.db" --SiftMatching.use_gpu 0 \
-        >"$dir/match.log" 2>&1
-    else
-      nice "$py" scripts/ci/colmap4.py database "$images" "$dir/full.db" --camera_params "$params" \
-        >"$dir/match.log" 2>&1
-    fi
+    match_demo "$matcher" "$images" "$dir"
     # shellcheck disable=SC2086 # PRUNE_ARGS is a list of options
     "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$dir/full.db" \
       --output "$dir/pruned.db"
     for variant in full pruned; do
       for mapper in global incremental; do
         out=$dir/${mapper}_$variant
-        nice "$py" scripts/ci/colmap4.py map "$mapper" "$dir/$variant.db" "$images" "$out" \
+        nice "$PY" scripts/ci/colmap4.py map "$mapper" "$dir/$variant.db" "$images" "$out" \
           >"$out.json" 2>"$out.log"
         # eval with a baseline counts false pairs; the full database is its own baseline.
         "$bin" eval --model "$out" --ground_truth "$work/scene/gt" \

@@ -13,12 +13,13 @@ runs=${2:-5}
 mappers=${3:-global incremental}
 bin=${VGSEL:-target/release/vgsel-colmap}
 [ -x "$bin" ] || cargo build --release --quiet
-py=$(bash scripts/ci/pycolmap-venv.sh)
+PY=$(bash scripts/ci/pycolmap-venv.sh)
+# shellcheck source=scripts/lab/demo-matching.sh
+source scripts/lab/demo-matching.sh
 rm -rf "$work"
 mkdir -p "$work"
 "$bin" generate images --scene duplicate --num_images 20 --seed 1 --output "$work/scene" -q
 images=$work/scene/images
-params=400,240,180,0
 score() { # MODEL DB -> correct/registered/models as JSON
   "$bin" eval --model "$1" --ground_truth "$work/scene/gt" --database_path "$2" --baseline "$dir/full.db"
 }
@@ -27,23 +28,13 @@ for run in $(seq 1 "$runs"); do
     dir=$work/$run/$matcher
     mkdir -p "$dir"
     echo "run $run: $matcher matching" >&2
-    if [ "$matcher" = colmap3.8 ]; then
-      nice colmap feature_extractor --database_path "$dir/full.db" --image_path "$images" \
-        --ImageReader.camera_model SIMPLE_RADIAL --ImageReader.single_camera 1 \
-        --ImageReader.camera_params "$params" --SiftExtraction.use_gpu 0 \
-        --SiftExtraction.max_num_features 1024 >"$dir/extract.log" 2>&1
-      nice colmap exhaustive_matcher --database_path "$dir/full.db" --SiftMatching.use_gpu 0 \
-        >"$dir/match.log" 2>&1
-    else
-      nice "$py" scripts/ci/colmap4.py database "$images" "$dir/full.db" --camera_params "$params" \
-        >"$dir/match.log" 2>&1
-    fi
+    match_demo "$matcher" "$images" "$dir"
     for mapper in $mappers; do
       db=$dir/$mapper.db
       cp "$dir/full.db" "$db"
       # shellcheck disable=SC2086 # PRUNE_ARGS is a list of options
       "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$db"
-      nice "$py" scripts/ci/colmap4.py map "$mapper" "$db" "$images" "$dir/${mapper}_1" \
+      nice "$PY" scripts/ci/colmap4.py map "$mapper" "$db" "$images" "$dir/${mapper}_1" \
         >"$dir/${mapper}_1.json" 2>"$dir/${mapper}_1.log"
       score "$dir/${mapper}_1" "$db" >"$dir/${mapper}_1.eval.json"
       status=0
@@ -53,7 +44,7 @@ for run in $(seq 1 "$runs"); do
         # shellcheck disable=SC2086
         "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$db" \
           --model "$dir/${mapper}_1"
-        nice "$py" scripts/ci/colmap4.py map "$mapper" "$db" "$images" "$dir/${mapper}_2" \
+        nice "$PY" scripts/ci/colmap4.py map "$mapper" "$db" "$images" "$dir/${mapper}_2" \
           >"$dir/${mapper}_2.json" 2>"$dir/${mapper}_2.log"
         score "$dir/${mapper}_2" "$db" >"$dir/${mapper}_2.eval.json"
         "$bin" check --model "$dir/${mapper}_2" --database_path "$db" \

@@ -1,0 +1,18 @@
+# Sourced by the demo-scene measurements (colmap4-mappers.sh, repair-loop.sh): one fresh matching
+# of the demo's 20 rendered images into DIR/full.db, by COLMAP 3.8 or by pycolmap 4.2 (PY, from
+# scripts/ci/pycolmap-venv.sh), 1024 SIFT features, the renderer's intrinsics given.
+# usage: match_demo MATCHER IMAGES DIR   (MATCHER: colmap3.8 | pycolmap4.2)
+match_demo() {
+  local matcher=$1 images=$2 dir=$3 params=400,240,180,0
+  if [ "$matcher" = colmap3.8 ]; then
+    nice colmap feature_extractor --database_path "$dir/full.db" --image_path "$images" \
+      --ImageReader.camera_model SIMPLE_RADIAL --ImageReader.single_camera 1 \
+      --ImageReader.camera_params "$params" --SiftExtraction.use_gpu 0 \
+      --SiftExtraction.max_num_features 1024 >"$dir/extract.log" 2>&1
+    nice colmap exhaustive_matcher --database_path "$dir/full.db" --SiftMatching.use_gpu 0 \
+      >"$dir/match.log" 2>&1
+  else
+    nice "$PY" scripts/ci/colmap4.py database "$images" "$dir/full.db" --camera_params "$params" \
+      >"$dir/match.log" 2>&1
+  fi
+}
