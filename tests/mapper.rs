@@ -5,7 +5,7 @@ use crate::support::run_ok;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use vgsel_colmap::colmap::model::read_images;
+use vgsel_colmap::colmap::sparse::read_images;
 use vgsel_colmap::eval::align::evaluate;
 use vgsel_colmap::eval::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
 

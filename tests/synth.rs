@@ -5,7 +5,7 @@ use rusqlite::{Connection, OptionalExtension};
 use std::collections::HashSet;
 use std::path::Path;
 use vgsel_colmap::colmap::ids::TwoViewConfig;
-use vgsel_colmap::colmap::model::read_images;
+use vgsel_colmap::colmap::sparse::read_images;
 use vgsel_colmap::eval::align::evaluate;
 use vgsel_colmap::eval::synth::{generate, pair_geometry, write_gt_model, GroundTruth, SceneSpec};
 

@@ -1,6 +1,6 @@
 //! A whole COLMAP sparse model, text or binary: cameras, images with their 2D points and the
 //! 3D point each lies on, and the 3D points' positions (tracks are the images' 2D points read
-//! the other way round). [`super::model`] reads only the poses; the model check needs the rest.
+//! the other way round); or only the images' poses ([`read_images`]).
 
 use super::ids::{camera_model_name, camera_model_num_params};
 use super::model::{read_text_cameras, ModelCamera, ModelImage, Reader};
@@ -37,6 +37,17 @@ pub struct SparseModel {
     pub images: Vec<SparseImage>,
     /// 3D point positions by POINT3D_ID.
     pub points: BTreeMap<u64, [f64; 3]>,
+}
+
+/// The images of the model in `dir` with their poses, `images.bin` if present, else
+/// `images.txt` (without their 2D points: what scoring a model against a ground truth needs).
+pub fn read_images(dir: &Path) -> Result<Vec<ModelImage>> {
+    let images = if dir.join("images.bin").is_file() {
+        read_binary_images(dir)?
+    } else {
+        read_text_images(dir)?
+    };
+    Ok(images.into_iter().map(|i| i.image).collect())
 }
 
 /// Reads the model in `dir`: `cameras`, `images` and `points3D`, each `.bin` if present, else
@@ -272,7 +283,98 @@ fn read_text_points(dir: &Path) -> Result<BTreeMap<u64, [f64; 3]>> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::model::{model_dirs, write_text_model};
     use super::*;
+
+    #[test]
+    fn reads_text_model_with_empty_point_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("images.txt"),
+            "# comment\n# Number of images: 2\n\
+             1 1 0 0 0 1 2 3 1 a.jpg\n\
+             10.5 20.5 -1 11.5 2.5 4 1.5 3.5 9\n\
+             2 0 1 0 0 0 0 1 1 b c.jpg\n\n",
+        )
+        .unwrap();
+        let images = read_images(dir.path()).unwrap();
+        assert_eq!(images.len(), 2);
+        assert_eq!(images[0].name, "a.jpg");
+        assert_eq!(images[1].name, "b c.jpg");
+        assert_eq!((images[0].observations, images[1].observations), (2, 0));
+        assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
+        assert!((images[1].centre() - Vector3::new(0.0, 0.0, 1.0)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn written_text_models_read_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let camera = ModelCamera {
+            camera_id: 3,
+            model: "RADIAL".into(),
+            width: 640,
+            height: 480,
+            params: vec![500.5, 320.0, 240.0, -0.1, 0.01],
+        };
+        let image = ModelImage {
+            image_id: 7,
+            camera_id: 3,
+            name: "a b.jpg".into(),
+            rotation: UnitQuaternion::from_euler_angles(0.1, -0.2, 0.3),
+            translation: Vector3::new(1.0, -2.0, 0.5),
+            observations: 0,
+        };
+        write_text_model(
+            dir.path(),
+            std::slice::from_ref(&camera),
+            std::slice::from_ref(&image),
+        )
+        .unwrap();
+        assert_eq!(read_text_cameras(dir.path()).unwrap(), vec![camera]);
+        let back = read_images(dir.path()).unwrap();
+        assert_eq!((back[0].image_id, back[0].camera_id), (7, 3));
+        assert_eq!(back[0].name, image.name);
+        assert!(back[0].rotation.angle_to(&image.rotation) < 1e-12);
+        assert!((back[0].translation - image.translation).norm() < 1e-12);
+    }
+
+    #[test]
+    fn binary_and_text_agree_and_sub_models_are_found() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("1");
+        std::fs::create_dir_all(&model).unwrap();
+        let mut bin = 1u64.to_le_bytes().to_vec();
+        bin.extend(7u32.to_le_bytes());
+        for x in [1.0f64, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0] {
+            bin.extend(x.to_le_bytes());
+        }
+        bin.extend(2u32.to_le_bytes());
+        bin.extend(b"a b.png\0");
+        // Three 2D points, the second on no 3D point.
+        bin.extend(3u64.to_le_bytes());
+        for id in [5u64, u64::MAX, 0] {
+            bin.extend([0u8; 16]);
+            bin.extend(id.to_le_bytes());
+        }
+        std::fs::write(model.join("images.bin"), &bin).unwrap();
+        assert_eq!(model_dirs(dir.path()).unwrap(), vec![model.clone()]);
+        let images = read_images(&model).unwrap();
+        assert_eq!(
+            (
+                images[0].image_id,
+                images[0].camera_id,
+                images[0].name.as_str()
+            ),
+            (7, 2, "a b.png")
+        );
+        assert_eq!(images[0].observations, 2);
+        assert!((images[0].centre() + Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
+        std::fs::write(model.join("images.bin"), &bin[..bin.len() - 1]).unwrap();
+        assert!(read_images(&model)
+            .unwrap_err()
+            .to_string()
+            .contains("truncated"));
+    }
 
     #[test]
     fn text_models_read_whole() {

@@ -18,6 +18,7 @@ use crate::colmap::database::{Camera, Database};
 use crate::colmap::ids::image_ids;
 use crate::colmap::ids::{camera_model_id, camera_model_num_params};
 use crate::colmap::model;
+use crate::colmap::sparse;
 use crate::eval::align::scene_extent;
 use crate::eval::render::Scene;
 use crate::eval::surface_truth::{transfer_error, TRANSFER_THRESHOLD_PX};
@@ -114,7 +115,7 @@ pub struct PairReport {
 }
 
 /// How a pair's inliers are judged: against the surfaces of the rendered scene the ground truth
-/// was written with (exact, [`surface_truth`]), or, for any other ground truth (photographs, the
+/// was written with (exact, [`crate::eval::surface_truth`]), or, for any other ground truth (photographs, the
 /// synthetic databases), by the epipolar geometry with rays that must meet in the scene.
 pub enum Judge {
     /// The renderer's geometry, rebuilt from the ground truth's `scene.json`.
@@ -217,7 +218,7 @@ fn median(mut errors: Vec<f64>) -> f64 {
 /// ground truth; keyed by pair_id.
 fn pair_errors(db: &Database, gt: &Path) -> Result<(Judge, HashMap<u64, Option<f64>>)> {
     let cameras = read_cameras(gt)?;
-    let images = model::read_images(gt)?;
+    let images = sparse::read_images(gt)?;
     let judge = Judge::for_truth(gt, &images)?;
     let truth: HashMap<String, model::ModelImage> =
         images.into_iter().map(|im| (im.name.clone(), im)).collect();
@@ -344,7 +345,7 @@ pub fn report(
 ) -> Result<PairReport> {
     let db = Database::open_read_only(db_path)?;
     let (judge, labels) = label_pairs(&db, gt)?;
-    let gt_names: HashSet<String> = model::read_images(gt)?
+    let gt_names: HashSet<String> = sparse::read_images(gt)?
         .into_iter()
         .map(|im| im.name)
         .collect();

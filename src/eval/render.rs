@@ -502,7 +502,7 @@ impl Scene {
              since, render again",
             path.display()
         );
-        let written = crate::colmap::model::read_images(gt)?;
+        let written = crate::colmap::sparse::read_images(gt)?;
         for im in &written {
             let rebuilt = scene.truth.images.iter().find(|r| r.name == im.name);
             ensure!(

@@ -5,6 +5,7 @@
 //! registered onto the other) registers images that are not correct.
 
 use crate::colmap::model;
+use crate::colmap::sparse;
 use crate::eval::align::{self, POSITION_TOLERANCE, ROTATION_TOLERANCE_DEG};
 use anyhow::{ensure, Result};
 use serde::Serialize;
@@ -52,7 +53,7 @@ pub struct Scores {
 /// ground-truth model in `ground_truth`. An image registered in several sub-models counts once,
 /// with its best score.
 pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
-    let truth = model::read_images(ground_truth)?;
+    let truth = sparse::read_images(ground_truth)?;
     ensure!(
         truth.len() >= 3,
         "ground truth {} has fewer than 3 images",
@@ -62,7 +63,7 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
     let mut best: HashMap<String, ImageScore> = HashMap::new();
     let mut observations = 0;
     for (index, dir) in dirs.iter().enumerate() {
-        let estimated = model::read_images(dir)?;
+        let estimated = sparse::read_images(dir)?;
         observations += estimated.iter().map(|im| im.observations).sum::<usize>();
         // A model of fewer than 2 known images cannot be aligned: its images stay unscored.
         let Ok(eval) = align::evaluate(&estimated, &truth) else {
@@ -117,7 +118,7 @@ pub fn registered(sparse: &Path) -> Result<Registered> {
     let dirs = model::model_dirs(sparse)?;
     let mut names = std::collections::HashSet::new();
     for dir in &dirs {
-        names.extend(model::read_images(dir)?.into_iter().map(|im| im.name));
+        names.extend(sparse::read_images(dir)?.into_iter().map(|im| im.name));
     }
     Ok(Registered {
         models: dirs.len(),
