@@ -22,8 +22,11 @@
 #   of: full disambiguation paper-disambiguation yan-0.30 yan-best cui-0.50 cui-top3 cui-best
 #   calibrator truth (default: all but truth, for both), VARIANTS ("order shuffled")
 # The checkout's Python needs numpy 1.23.5 and friends: a venv at WORKDIR/peers-venv (PyPI).
+# Its package alone is enough (`git archive HEAD disambiguation | tar -x -C DIR`).
+# Oats: its reference cannot judge the link frames; judge its models (WORKDIR/oats/measure/
+# sparse_*) with scripts/lab/two-copies.py, as lab-summary.py does.
 set -euo pipefail
-[ $# -ge 2 ] || { sed -n '13,24p' "$0" >&2; exit 2; }
+[ $# -ge 2 ] || { sed -n '13,27p' "$0" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/../.." && pwd)
 peers=$(cd "$1" && pwd)
 mkdir -p "$2"
