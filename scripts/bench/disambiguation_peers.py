@@ -16,7 +16,9 @@ usage:
       COLMAP 4.2's `calibrate_view_graph` (the `view_graph_calibrator` command) on a copy of DB:
       the pairs it leaves valid, OUT/keep/calibrator.txt.
   disambiguation_peers.py table WORK SCENE...      (any python 3)
-      one Markdown table of every run lab-measure.py has finished in WORK/SCENE/measure.
+      one Markdown table of every run lab-measure.py has finished in WORK/SCENE/measure, each
+      model cell with `vgsel-colmap check`'s verdict on it (VGSEL: the binary,
+      target/release/vgsel-colmap by default): "flagged" when check calls it ghosted.
 
 Settings: the checkout's README and its notebooks for the small yan2017 scenes. Yan: track
 degree 3, coverage 0.9, alpha 0.1, at least 5 shared unique tracks, pairs kept at a score >= 0.3
@@ -30,6 +32,7 @@ then the most true pairs, judged by the same pair labels the table reports.
 import json
 import os
 import shutil
+import subprocess
 import sys
 import types
 
@@ -173,6 +176,14 @@ METHODS = {"full": "full database", "disambiguation": "`--preset disambiguation`
            "truth": "true pairs only (bound)"}
 
 
+def check(run):
+    """`vgsel-colmap check`'s verdict on the run's model folder: flagged (exit 3) or clean."""
+    vgsel = os.environ.get("VGSEL", "target/release/vgsel-colmap")
+    status = subprocess.run([vgsel, "check", "--model", run["sparse"]],
+                            capture_output=True).returncode
+    return {0: "clean", 3: "flagged"}.get(status, f"check error {status}")
+
+
 def verdict(run, truth):
     if run["models"] == 0:
         return "no model"
@@ -184,7 +195,7 @@ def verdict(run, truth):
     if not whole:
         models = "1 model" if run["models"] == 1 else f"{run['models']} models"
         cell += f" ({run['registered']} reg., {models})"
-    return cell
+    return f"{cell} · {check(run)}"
 
 
 def table(work, scenes):
