@@ -3,11 +3,11 @@
 //! the other way round); or only the images' poses ([`read_images`]).
 
 use super::ids::{camera_model_name, camera_model_num_params};
-use super::model::{read_text_cameras, ModelCamera, ModelImage, Reader};
+use super::model::{read_text_cameras, ModelCamera, ModelImage};
 use anyhow::{ensure, Context, Result};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// One keypoint of a model image: its pixel position (COLMAP's convention, 0.5 the first
 /// pixel's centre) and the 3D point it was triangulated into, if any.
@@ -70,27 +70,75 @@ pub fn read_sparse_model(dir: &Path) -> Result<SparseModel> {
     Ok(model)
 }
 
-fn file_bytes(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).with_context(|| format!("reading {}", path.display()))
+/// A little-endian cursor over a binary model file, whose errors name the file and offset.
+struct Reader {
+    bytes: Vec<u8>,
+    at: usize,
+    path: PathBuf,
+}
+
+impl Reader {
+    /// The whole file at `path`, from its first byte.
+    fn open(path: &Path) -> Result<Reader> {
+        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        Ok(Reader {
+            bytes,
+            at: 0,
+            path: path.to_path_buf(),
+        })
+    }
+
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        ensure!(
+            self.at + n <= self.bytes.len(),
+            "{}: truncated at byte {}",
+            self.path.display(),
+            self.at
+        );
+        self.at += n;
+        Ok(&self.bytes[self.at - n..self.at])
+    }
+    fn skip(&mut self, n: usize) -> Result<()> {
+        self.take(n).map(|_| ())
+    }
+    fn u32(&mut self) -> Result<u32> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn u64(&mut self) -> Result<u64> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn f64(&mut self) -> Result<f64> {
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn name(&mut self) -> Result<String> {
+        let rest = &self.bytes[self.at..];
+        let end = rest
+            .iter()
+            .position(|&b| b == 0)
+            .with_context(|| format!("{}: unterminated name", self.path.display()))?;
+        let name = String::from_utf8_lossy(&rest[..end]).into_owned();
+        self.at += end + 1;
+        Ok(name)
+    }
 }
 
 /// `cameras.bin`: u64 count, then per camera u32 id, i32 model, u64 width, u64 height and the
 /// model's f64 parameters.
 fn read_binary_cameras(dir: &Path) -> Result<Vec<ModelCamera>> {
-    let path = dir.join("cameras.bin");
-    let bytes = file_bytes(&path)?;
-    let mut r = Reader {
-        bytes: &bytes,
-        at: 0,
-        path: &path,
-    };
+    let mut r = Reader::open(&dir.join("cameras.bin"))?;
     let mut out = Vec::new();
     for _ in 0..r.u64()? {
         let camera_id = r.u32()?;
         let model_id = r.u32()? as i32;
         let (width, height) = (r.u64()? as u32, r.u64()? as u32);
         let n = camera_model_num_params(model_id)
-            .with_context(|| format!("{}: unknown camera model {model_id}", path.display()))?;
+            .with_context(|| format!("{}: unknown camera model {model_id}", r.path.display()))?;
         let params = (0..n).map(|_| r.f64()).collect::<Result<Vec<_>>>()?;
         let model = camera_model_name(model_id).unwrap_or("UNKNOWN");
         out.push(ModelCamera {
@@ -133,13 +181,7 @@ fn sparse_image(
 /// `images.bin`: per image u32 id, 4 f64 qvec, 3 f64 tvec, u32 camera id, a NUL-terminated
 /// name, u64 point count and that many (f64 x, f64 y, i64 point3D id).
 fn read_binary_images(dir: &Path) -> Result<Vec<SparseImage>> {
-    let path = dir.join("images.bin");
-    let bytes = file_bytes(&path)?;
-    let mut r = Reader {
-        bytes: &bytes,
-        at: 0,
-        path: &path,
-    };
+    let mut r = Reader::open(&dir.join("images.bin"))?;
     let mut out = Vec::new();
     for _ in 0..r.u64()? {
         let image_id = r.u32()?;
@@ -163,13 +205,7 @@ fn read_binary_images(dir: &Path) -> Result<Vec<SparseImage>> {
 /// `points3D.bin`: per point u64 id, 3 f64 xyz, 3 u8 colour, f64 error, u64 track length and
 /// that many (u32 image id, u32 point2D index).
 fn read_binary_points(dir: &Path) -> Result<BTreeMap<u64, [f64; 3]>> {
-    let path = dir.join("points3D.bin");
-    let bytes = file_bytes(&path)?;
-    let mut r = Reader {
-        bytes: &bytes,
-        at: 0,
-        path: &path,
-    };
+    let mut r = Reader::open(&dir.join("points3D.bin"))?;
     let mut out = BTreeMap::new();
     for _ in 0..r.u64()? {
         let id = r.u64()?;
