@@ -379,19 +379,15 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let model = dir.path().join("1");
         std::fs::create_dir_all(&model).unwrap();
-        let mut bin = 1u64.to_le_bytes().to_vec();
-        bin.extend(7u32.to_le_bytes());
-        for x in [1.0f64, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0] {
-            bin.extend(x.to_le_bytes());
-        }
-        bin.extend(2u32.to_le_bytes());
-        bin.extend(b"a b.png\0");
         // Three 2D points, the second on no 3D point.
-        bin.extend(3u64.to_le_bytes());
-        for id in [5u64, u64::MAX, 0] {
-            bin.extend([0u8; 16]);
-            bin.extend(id.to_le_bytes());
-        }
+        let points = [([0.0, 0.0], 5), ([0.0, 0.0], u64::MAX), ([0.0, 0.0], 0)];
+        let bin = one_image_bin(
+            7,
+            [1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0],
+            2,
+            "a b.png",
+            &points,
+        );
         std::fs::write(model.join("images.bin"), &bin).unwrap();
         assert_eq!(model_dirs(dir.path()).unwrap(), vec![model.clone()]);
         let images = read_images(&model).unwrap();
@@ -441,6 +437,29 @@ mod tests {
         assert_eq!(m.points[&5], [0.5, 1.0, 2.0]);
     }
 
+    /// `images.bin` of one image: its id, qvec and tvec, camera, name and 2D points (x, y and
+    /// point3D id; u64::MAX for none).
+    fn one_image_bin(
+        image_id: u32,
+        pose: [f64; 7],
+        camera_id: u32,
+        name: &str,
+        points: &[([f64; 2], u64)],
+    ) -> Vec<u8> {
+        let mut bin = 1u64.to_le_bytes().to_vec();
+        bin.extend(image_id.to_le_bytes());
+        pose.iter().for_each(|x| bin.extend(x.to_le_bytes()));
+        bin.extend(camera_id.to_le_bytes());
+        bin.extend(name.as_bytes());
+        bin.push(0);
+        bin.extend((points.len() as u64).to_le_bytes());
+        for (xy, id) in points {
+            xy.iter().for_each(|x| bin.extend(x.to_le_bytes()));
+            bin.extend(id.to_le_bytes());
+        }
+        bin
+    }
+
     #[test]
     fn binary_models_read_whole() {
         let dir = tempfile::tempdir().unwrap();
@@ -454,18 +473,13 @@ mod tests {
             cams.extend(x.to_le_bytes());
         }
         std::fs::write(d.join("cameras.bin"), cams).unwrap();
-        let mut ims = 1u64.to_le_bytes().to_vec();
-        ims.extend(7u32.to_le_bytes());
-        for x in [1.0f64, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0] {
-            ims.extend(x.to_le_bytes());
-        }
-        ims.extend(3u32.to_le_bytes());
-        ims.extend(b"a.png\0");
-        ims.extend(1u64.to_le_bytes());
-        for x in [12.5f64, 7.5] {
-            ims.extend(x.to_le_bytes());
-        }
-        ims.extend(9u64.to_le_bytes());
+        let ims = one_image_bin(
+            7,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            3,
+            "a.png",
+            &[([12.5, 7.5], 9)],
+        );
         std::fs::write(d.join("images.bin"), ims).unwrap();
         let mut pts = 1u64.to_le_bytes().to_vec();
         pts.extend(9u64.to_le_bytes());
