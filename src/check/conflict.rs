@@ -2,7 +2,9 @@
 //! where a point that group A saw projects into an image b of group B that looks at it from
 //! nearly the same direction, b saw something there too. If some of what b saw there is also
 //! A's, the two groups agree about that place; if all of it is b's group's alone, b sees other
-//! structure exactly where A's is: the two groups are copies placed onto each other.
+//! structure exactly where A's is: the two groups are copies placed onto each other, unless the
+//! database matched b's keypoints there to A's (the same structure, kept as two tracks:
+//! [`super::evidence`]).
 
 use super::views::Views;
 use serde::Serialize;
@@ -13,6 +15,10 @@ pub struct ConflictSettings {
     /// Largest angle, in degrees, between b's ray to the point and the ray of an image of A that
     /// saw it: beyond it, b might not see the point as A did (other side, occlusion, scale).
     pub max_angle_deg: f64,
+    /// Largest ratio (either way) between b's distance to the point and that image of A's: at
+    /// another scale b detects other features there (closer, finer texture; farther, only the
+    /// coarse), which is no conflict. The same image of A must pass both tests.
+    pub max_scale: f64,
     /// Neighbourhood radius around the projection, as a fraction of the image diagonal.
     pub radius: f64,
     /// Triangulated keypoints b needs in the neighbourhood for the sample to count.
@@ -25,8 +31,11 @@ pub struct Counts {
     /// Samples (a point of one group projected into an image of the other that did not see
     /// it) whose neighbourhood holds only structure of the image's own group.
     pub conflicting: usize,
-    /// Samples whose neighbourhood holds structure both groups saw.
+    /// Samples whose neighbourhood holds structure both groups saw, or keypoints the database
+    /// matched to the projecting image's around the point.
     pub agreeing: usize,
+    /// Of the agreeing, those only the database's matches showed.
+    pub matched: usize,
     /// Samples where the image saw the point itself.
     pub seen: usize,
 }
@@ -73,52 +82,89 @@ pub fn count(views: &Views, side: &[bool], settings: &ConflictSettings) -> Count
                 counts.seen += 1;
                 continue;
             }
-            let from: Vec<usize> = track
+            let from: Vec<(usize, u32)> = track
                 .iter()
                 .copied()
-                .filter(|&a| usize::from(side[a]) != group)
+                .zip(views.observed_at[k].iter().copied())
+                .filter(|&(a, _)| usize::from(side[a]) != group)
                 .collect();
             let ours = |j: usize| member[j][1 - group];
-            match judge(views, k, b, &from, &ours, settings) {
-                Some(true) => counts.conflicting += 1,
-                Some(false) => counts.agreeing += 1,
-                None => {}
-            }
+            counts.add(judge(views, k, b, &from, &ours, settings));
         }
     }
     counts
 }
 
-/// How one sample ends: `None` when not judged (behind, outside, too oblique, nothing near).
-/// `ours(j)` says whether point `j` belongs to the projecting side.
+/// How a sample ended.
+enum Sample {
+    /// Only the image's own group's structure near the projection.
+    Conflicting,
+    /// Structure both groups saw near the projection.
+    Agreeing,
+    /// Only the own group's, but the database matched it to the projecting image's.
+    Matched,
+}
+
+impl Counts {
+    fn add(&mut self, sample: Option<Sample>) {
+        match sample {
+            Some(Sample::Conflicting) => self.conflicting += 1,
+            Some(Sample::Agreeing) => self.agreeing += 1,
+            Some(Sample::Matched) => {
+                self.agreeing += 1;
+                self.matched += 1;
+            }
+            None => {}
+        }
+    }
+}
+
+/// How one sample ends: `None` when not judged (behind, outside, too oblique or far off in
+/// scale, nothing near). `from` are the projecting side's observations of point `k` (view,
+/// keypoint); `ours(j)` says whether point `j` belongs to the projecting side.
 fn judge(
     views: &Views,
     k: usize,
     b: usize,
-    from: &[usize],
+    from: &[(usize, u32)],
     ours: &dyn Fn(usize) -> bool,
     settings: &ConflictSettings,
-) -> Option<bool> {
+) -> Option<Sample> {
     let x = views.points[k];
     let view = &views.views[b];
-    let ray = (x - view.centre).normalize();
+    let to_b = x - view.centre;
     let cos_max = settings.max_angle_deg.to_radians().cos();
-    let close = from
-        .iter()
-        .any(|&a| ray.dot(&(x - views.views[a].centre).normalize()) >= cos_max);
+    let close = from.iter().any(|&(a, _)| {
+        let to_a = x - views.views[a].centre;
+        let scale = to_b.norm() / to_a.norm();
+        to_b.normalize().dot(&to_a.normalize()) >= cos_max
+            && scale <= settings.max_scale
+            && scale * settings.max_scale >= 1.0
+    });
     if !close {
         return None;
     }
     let at = views.project(b, k)?;
-    let radius = settings.radius * view.intrinsics.width.hypot(view.intrinsics.height);
+    let radius = views.radius(b, settings.radius);
     let mut n = 0;
     for j in views.neighbours(b, at, radius) {
         if ours(j) {
-            return Some(false);
+            return Some(Sample::Agreeing);
         }
         n += 1;
     }
-    (n >= settings.min_neighbours).then_some(true)
+    if n < settings.min_neighbours {
+        return None;
+    }
+    let matched = from.iter().any(|&(a, keypoint)| {
+        let seen = views.views[a].keypoints[keypoint as usize];
+        views.matched_near((a, seen, views.radius(a, settings.radius)), (b, at, radius))
+    });
+    Some(if matched {
+        Sample::Matched
+    } else {
+        Sample::Conflicting
+    })
 }
 
 /// The conflicts between two single images `a` and `b`, both ways: their points the other did
@@ -132,11 +178,11 @@ pub fn pair_counts(views: &Views, a: usize, b: usize, settings: &ConflictSetting
                 counts.seen += 1;
                 continue;
             }
-            match judge(views, k, to, &[from], &ours, settings) {
-                Some(true) => counts.conflicting += 1,
-                Some(false) => counts.agreeing += 1,
-                None => {}
-            }
+            let Ok(at) = views.observers[k].binary_search(&from) else {
+                continue;
+            };
+            let observation = (from, views.observed_at[k][at]);
+            counts.add(judge(views, k, to, &[observation], &ours, settings));
         }
     }
     counts

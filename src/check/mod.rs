@@ -9,6 +9,7 @@
 //! what it assumes and its measurements.
 
 pub mod conflict;
+pub mod evidence;
 pub mod plot;
 pub mod splits;
 pub mod views;
@@ -17,8 +18,9 @@ use crate::colmap::database::Database;
 use crate::colmap::sparse::SparseModel;
 use anyhow::Result;
 use conflict::{ConflictSettings, Counts};
+use evidence::Evidence;
 use serde::Serialize;
-use std::collections::{BTreeMap, HashSet};
+use std::collections::BTreeMap;
 use views::Views;
 
 /// Everything the check's verdict depends on.
@@ -42,6 +44,7 @@ pub struct CheckSettings {
 pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     conflict: ConflictSettings {
         max_angle_deg: 30.0,
+        max_scale: 1.25,
         radius: 0.02,
         min_neighbours: 1,
     },
@@ -103,41 +106,15 @@ pub struct ModelCheck {
     pub views: Option<Views>,
 }
 
-/// Verified pairs of `db` by image names (in name order) with their inliers, without the pairs
-/// a prune invalidated: the pairs a mapper run on `db` could use.
-pub fn database_pairs(db: &Database) -> Result<BTreeMap<(String, String), usize>> {
-    let names: BTreeMap<u32, String> = db
-        .images()?
-        .into_iter()
-        .map(|im| (im.image_id, im.name))
-        .collect();
-    let invalid: HashSet<u64> = db.invalidated_pair_ids()?;
-    let mut out = BTreeMap::new();
-    for g in db.geometries()? {
-        let id = crate::colmap::ids::pair_id(g.image_id1, g.image_id2);
-        if invalid.contains(&id) {
-            continue;
-        }
-        if let (Some(a), Some(b)) = (names.get(&g.image_id1), names.get(&g.image_id2)) {
-            let key = if a < b {
-                (a.clone(), b.clone())
-            } else {
-                (b.clone(), a.clone())
-            };
-            out.insert(key, g.num_inliers);
-        }
-    }
-    Ok(out)
-}
-
-/// Checks one model. `pairs` are [`database_pairs`] (`None`: joining pairs are the model's
-/// cross-group links).
+/// Checks one model, with the database's evidence if there is one (without: joining pairs are
+/// the model's cross-group links, and split tracks count as conflicts).
 pub fn check_model(
     model: &SparseModel,
-    pairs: Option<&BTreeMap<(String, String), usize>>,
+    evidence: Option<&Evidence>,
     settings: &CheckSettings,
 ) -> Result<ModelCheck> {
-    let views = Views::new(model, settings.conflict.radius)?;
+    let views = Views::new(model, settings.conflict.radius, evidence)?;
+    let pairs = evidence.map(|e| &e.pairs);
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
     let candidates = candidates(&views, &covisibility, settings);
@@ -292,19 +269,21 @@ fn describe(
 }
 
 /// The repair's evidence (`prune --model DIR`): in each model of `dir` (a model folder or a
-/// mapper's output_path) that the check finds ghosted, the pairs of images across its worst
+/// mapper's output_path) that the check finds ghosted (with `db`'s matches), the pairs of images across its worst
 /// split that share 3D points: the pairs whose matches glued one copy onto the other. Pairs
 /// across the split that share no point are not blamed: in a ghosted model they are mostly the
 /// true links the mapper could not use (measured on the demo scene: docs/check.md). Name pairs,
 /// sorted; empty when no model is ghosted.
 pub fn conflicting_pairs(
     dir: &std::path::Path,
+    db: &Database,
     settings: &CheckSettings,
 ) -> Result<Vec<[String; 2]>> {
+    let evidence = Evidence::load(db)?;
     let mut blamed = std::collections::BTreeSet::new();
     for model_dir in crate::colmap::model::model_dirs(dir)? {
         let model = crate::colmap::sparse::read_sparse_model(&model_dir)?;
-        let checked = check_model(&model, None, settings)?;
+        let checked = check_model(&model, Some(&evidence), settings)?;
         let Some(worst) = checked.worst.filter(|_| checked.ghosted) else {
             continue;
         };

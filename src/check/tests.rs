@@ -45,18 +45,30 @@ fn wall(rng: &mut Lcg, count: usize, first: u64) -> Vec<(u64, [f64; 3])> {
 /// An image at x = `x` looking along +z, observing each of `points` in view with probability
 /// `keep`.
 fn image(id: u32, x: f64, points: &[(u64, [f64; 3])], keep: f64, rng: &mut Lcg) -> SparseImage {
+    image_at(id, [x, 0.0], points, keep, rng)
+}
+
+/// [`image`] at x, z = `at`.
+fn image_at(
+    id: u32,
+    at: [f64; 2],
+    points: &[(u64, [f64; 3])],
+    keep: f64,
+    rng: &mut Lcg,
+) -> SparseImage {
+    let [x, z] = at;
     let view = ModelImage {
         image_id: id,
         camera_id: 1,
         name: format!("{id:04}.png"),
         rotation: UnitQuaternion::identity(),
-        translation: Vector3::new(-x, 0.0, 0.0),
+        translation: Vector3::new(-x, 0.0, -z),
         observations: 0,
     };
     let intrinsics = views::Intrinsics::from_camera(&camera());
     let mut points2d = Vec::new();
     for (pid, p) in points {
-        let at = Vector3::new(p[0] - x, p[1], p[2]);
+        let at = Vector3::new(p[0] - x, p[1], p[2] - z);
         if let Some(xy) = intrinsics.project(&at) {
             if rng.next() < keep {
                 points2d.push(Point2D {
@@ -94,6 +106,11 @@ fn correct_model() -> SparseModel {
 /// Two walls at the same place, each seen by its own six cameras only, and a small object
 /// (points at z = 4.5 in the middle) that all twelve see.
 fn ghosted_model() -> SparseModel {
+    ghosted_model_at(0.0)
+}
+
+/// [`ghosted_model`] with the second wall's cameras moved back by `back`.
+fn ghosted_model_at(back: f64) -> SparseModel {
     let mut rng = Lcg(11);
     let first = wall(&mut rng, 2000, 0);
     let second = wall(&mut rng, 2000, 10_000);
@@ -104,7 +121,14 @@ fn ghosted_model() -> SparseModel {
     for k in 0..12u32 {
         let mut seen = object.clone();
         seen.extend(if k % 2 == 0 { &first } else { &second });
-        images.push(image(k + 1, -1.5 + 0.25 * k as f64, &seen, 0.6, &mut rng));
+        let z = if k % 2 == 0 { 0.0 } else { -back };
+        images.push(image_at(
+            k + 1,
+            [-1.5 + 0.25 * k as f64, z],
+            &seen,
+            0.6,
+            &mut rng,
+        ));
     }
     let all: Vec<_> = first
         .iter()
@@ -163,4 +187,88 @@ fn projection_applies_radial_distortion() {
     assert!(views::Intrinsics::from_camera(&c)
         .project(&Vector3::new(0.0, 0.0, -1.0))
         .is_none());
+}
+
+/// The correct model's wall seen by twelve cameras in a row, but triangulated twice: the first
+/// six cameras' tracks and the last six's are separate points at the same places (what a
+/// selection without pairs between the two halves gives). With the database's matches between
+/// the halves the check sees one structure; without them, two copies.
+fn split_tracks_model() -> (SparseModel, Evidence) {
+    const SECOND: u64 = 100_000;
+    let mut rng = Lcg(7);
+    let points = wall(&mut rng, 3000, 0);
+    let moved: Vec<(u64, [f64; 3])> = points.iter().map(|&(id, p)| (id + SECOND, p)).collect();
+    let images: Vec<SparseImage> = (0..12)
+        .map(|k| {
+            let seen = if k < 6 { &points } else { &moved };
+            image(k + 1, -3.0 + 0.5 * k as f64, seen, 0.6, &mut rng)
+        })
+        .collect();
+    // Keypoint index of each wall point (by its first-half id) in each image.
+    let keypoint_of = |im: &SparseImage| -> BTreeMap<u64, u32> {
+        im.points2d
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (p.point3d_id.unwrap() % SECOND, k as u32))
+            .collect()
+    };
+    let mut evidence = Evidence::default();
+    for a in &images[..6] {
+        for b in &images[6..] {
+            let (ka, kb) = (keypoint_of(a), keypoint_of(b));
+            let m: Vec<[u32; 2]> = ka
+                .iter()
+                .filter_map(|(id, &x)| kb.get(id).map(|&y| [x, y]))
+                .collect();
+            evidence
+                .matches
+                .insert((a.image.name.clone(), b.image.name.clone()), m);
+        }
+    }
+    let all: Vec<_> = points.iter().chain(&moved).copied().collect();
+    (model(images, &all), evidence)
+}
+
+#[test]
+fn tracks_a_selection_split_are_one_structure_by_the_database_s_matches() {
+    let (model, evidence) = split_tracks_model();
+    let without = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
+    assert!(without.ghosted, "score {}", without.score);
+    let with = check_model(&model, Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    assert!(!with.ghosted, "score {}", with.score);
+    assert!(with.score < 0.2, "score {}", with.score);
+    assert!(with.worst.unwrap().counts.matched > 0);
+}
+
+#[test]
+fn matches_do_not_hide_two_copies() {
+    // Every keypoint of every image matched to every other image's keypoint at the same index:
+    // matches that do not land where the point is seen are no evidence.
+    let model = ghosted_model();
+    let mut evidence = Evidence::default();
+    for a in &model.images {
+        for b in &model.images {
+            if a.image.name < b.image.name {
+                let n = a.points2d.len().min(b.points2d.len()) as u32;
+                let m = (0..n).map(|k| [k, (k * 7919) % n]).collect();
+                evidence
+                    .matches
+                    .insert((a.image.name.clone(), b.image.name.clone()), m);
+            }
+        }
+    }
+    let check = check_model(&model, Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    assert!(check.ghosted, "score {}", check.score);
+}
+
+#[test]
+fn images_at_another_scale_are_not_asked_to_see_the_same_features() {
+    // The second wall's cameras twice as far (10 instead of 5): closer images detect finer
+    // structure, so what they do not share says nothing.
+    let check = check_model(&ghosted_model_at(5.0), None, &DEFAULT_SETTINGS).unwrap();
+    assert!(!check.ghosted, "score {}", check.score);
+    let mut wide = DEFAULT_SETTINGS;
+    wide.conflict.max_scale = 2.5;
+    let check = check_model(&ghosted_model_at(5.0), None, &wide).unwrap();
+    assert!(check.ghosted, "score {}", check.score);
 }

@@ -1,7 +1,9 @@
 //! A model made ready for the check: each registered image with its centre, its projection
 //! (pinhole plus COLMAP's radial/tangential distortion) and a grid of its triangulated
-//! keypoints; each 3D point with the images that observe it.
+//! keypoints; each 3D point with the images that observe it; with a database, the verified
+//! matches between the registered images ([`super::evidence`]).
 
+use super::evidence::Evidence;
 use crate::colmap::model::ModelCamera;
 use crate::colmap::sparse::SparseModel;
 use anyhow::{Context, Result};
@@ -91,6 +93,9 @@ pub struct View {
     pub intrinsics: Intrinsics,
     /// Triangulated keypoints in grid cells of [`Views::cell`] pixels: (x, y, point index).
     pub grid: Grid,
+    /// Every keypoint's position, by keypoint index (the model's points2D order, which is the
+    /// database's).
+    pub keypoints: Vec<[f64; 2]>,
 }
 
 /// The model as the check reads it. Points and views are indexed densely, in id order.
@@ -102,16 +107,22 @@ pub struct Views {
     pub points: Vec<Vector3<f64>>,
     /// For each point, the views observing it (sorted, no repeats).
     pub observers: Vec<Vec<usize>>,
+    /// For each point, the keypoint index of each observation, in `observers`' order.
+    pub observed_at: Vec<Vec<u32>>,
     /// For each view, the points it observes (sorted, no repeats).
     pub seen_by: Vec<Vec<usize>>,
     /// Grid cell size in pixels (the neighbourhood radius).
     pub cell: f64,
+    /// Verified matches between registered views, both ways: (a, b) -> (keypoint of a,
+    /// keypoint of b). Empty without a database.
+    pub matches: HashMap<(usize, usize), Vec<[u32; 2]>>,
 }
 
 impl Views {
     /// Prepares `model`; `radius` is the neighbourhood radius as a fraction of each image's
-    /// diagonal (the grid is built for the largest image's radius).
-    pub fn new(model: &SparseModel, radius: f64) -> Result<Views> {
+    /// diagonal (the grid is built for the largest image's radius); `evidence` gives the
+    /// matches.
+    pub fn new(model: &SparseModel, radius: f64, evidence: Option<&Evidence>) -> Result<Views> {
         let cameras: BTreeMap<u32, &ModelCamera> =
             model.cameras.iter().map(|c| (c.camera_id, c)).collect();
         let index: BTreeMap<u64, usize> = model
@@ -132,7 +143,7 @@ impl Views {
         let cell = (radius * diagonal).max(1.0);
         let mut images: Vec<_> = model.images.iter().collect();
         images.sort_by_key(|im| im.image.image_id);
-        let mut observers = vec![Vec::new(); index.len()];
+        let mut tracks: Vec<Vec<(usize, u32)>> = vec![Vec::new(); index.len()];
         let mut views = Vec::new();
         for (v, im) in images.iter().enumerate() {
             let camera = cameras.get(&im.image.camera_id).with_context(|| {
@@ -142,11 +153,11 @@ impl Views {
                 )
             })?;
             let mut grid = Grid::new();
-            for p in &im.points2d {
+            for (keypoint, p) in im.points2d.iter().enumerate() {
                 let Some(k) = p.point3d_id.and_then(|id| index.get(&id)) else {
                     continue;
                 };
-                observers[*k].push(v);
+                tracks[*k].push((v, keypoint as u32));
                 let key = (
                     (p.xy[0] / cell).floor() as i64,
                     (p.xy[1] / cell).floor() as i64,
@@ -161,21 +172,53 @@ impl Views {
                 centre: im.image.centre(),
                 intrinsics: Intrinsics::from_camera(camera),
                 grid,
+                keypoints: im.points2d.iter().map(|p| p.xy).collect(),
             });
         }
         let mut seen_by = vec![Vec::new(); views.len()];
-        for (k, o) in observers.iter_mut().enumerate() {
-            o.sort_unstable();
-            o.dedup();
-            o.iter().for_each(|&v| seen_by[v].push(k));
+        let (mut observers, mut observed_at) = (Vec::new(), Vec::new());
+        for (k, mut track) in tracks.into_iter().enumerate() {
+            track.sort_unstable();
+            track.dedup_by_key(|o| o.0);
+            track.iter().for_each(|&(v, _)| seen_by[v].push(k));
+            observers.push(track.iter().map(|o| o.0).collect());
+            observed_at.push(track.iter().map(|o| o.1).collect());
         }
+        let matches = evidence.map_or_else(HashMap::new, |e| view_matches(&views, e));
         Ok(Views {
             views,
             points,
             observers,
+            observed_at,
             seen_by,
             cell,
+            matches,
         })
+    }
+
+    /// Whether view `b`'s keypoints within `radius_b` pixels of `at` are matched to keypoints
+    /// of view `a` within `radius_a` of `from`: the two saw the same structure there.
+    pub fn matched_near(
+        &self,
+        (a, from, radius_a): (usize, [f64; 2], f64),
+        (b, at, radius_b): (usize, [f64; 2], f64),
+    ) -> bool {
+        let near = |xy: Option<&[f64; 2]>, to: [f64; 2], r: f64| {
+            xy.is_some_and(|xy| (xy[0] - to[0]).hypot(xy[1] - to[1]) <= r)
+        };
+        let (ka, kb) = (&self.views[a].keypoints, &self.views[b].keypoints);
+        self.matches.get(&(a, b)).is_some_and(|m| {
+            m.iter().any(|&[x, y]| {
+                near(kb.get(y as usize), at, radius_b) && near(ka.get(x as usize), from, radius_a)
+            })
+        })
+    }
+
+    /// Neighbourhood radius in view `v`'s pixels for a radius given as a fraction of the
+    /// diagonal.
+    pub fn radius(&self, v: usize, fraction: f64) -> f64 {
+        let i = &self.views[v].intrinsics;
+        fraction * i.width.hypot(i.height)
     }
 
     /// The points observed by view `v` within `radius` pixels of `at` (indices, may repeat).
@@ -204,4 +247,21 @@ impl Views {
         view.intrinsics
             .project(&(view.rotation * self.points[k] + view.translation))
     }
+}
+
+/// The evidence's matches between registered views, by view index, both ways.
+fn view_matches(views: &[View], evidence: &Evidence) -> HashMap<(usize, usize), Vec<[u32; 2]>> {
+    let index: HashMap<&str, usize> = views
+        .iter()
+        .enumerate()
+        .map(|(v, view)| (view.name.as_str(), v))
+        .collect();
+    let mut out = HashMap::new();
+    for ((n1, n2), m) in &evidence.matches {
+        if let (Some(&a), Some(&b)) = (index.get(n1.as_str()), index.get(n2.as_str())) {
+            out.insert((b, a), m.iter().map(|&[x, y]| [y, x]).collect());
+            out.insert((a, b), m.clone());
+        }
+    }
+    out
 }

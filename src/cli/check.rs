@@ -4,6 +4,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
+use vgsel_colmap::check::evidence::Evidence;
 use vgsel_colmap::check::{self, CheckSettings, ModelCheck, DEFAULT_SETTINGS};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
@@ -19,7 +20,8 @@ pub struct CheckArgs {
     /// each is checked.
     #[arg(long, value_name = "DIR")]
     model: PathBuf,
-    /// The database the model was made from: names the verified pairs that join the groups.
+    /// The database the model was made from: names the verified pairs that join the groups, and
+    /// its matches tell the same structure kept as two tracks from two copies (recommended).
     #[arg(long, value_name = "DB")]
     database_path: Option<PathBuf>,
     /// Write the JSON report to FILE.
@@ -35,6 +37,10 @@ pub struct CheckArgs {
     /// what the other saw.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
     max_angle: f64,
+    /// Expert: largest ratio between two images' distances to a point for one to be expected to
+    /// see what the other saw there.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_scale)]
+    max_scale: f64,
     /// Expert: neighbourhood radius around a projected point, as a fraction of the image diagonal.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.radius, value_parser = super::args::fraction)]
     radius: f64,
@@ -54,6 +60,7 @@ impl CheckArgs {
         let mut s = DEFAULT_SETTINGS;
         s.threshold = self.threshold;
         s.conflict.max_angle_deg = self.max_angle;
+        s.conflict.max_scale = self.max_scale.max(1.0);
         s.conflict.radius = self.radius;
         s.min_group = self.min_group.max(1);
         s.min_conflicts = self.min_conflicts;
@@ -94,8 +101,8 @@ fn verdict_line(dir: &Path, c: &ModelCheck) -> String {
 /// Runs the check; Ok(true) when some model is ghosted.
 pub fn run(args: &CheckArgs) -> Result<bool> {
     let settings = args.settings();
-    let pairs = match &args.database_path {
-        Some(path) => Some(check::database_pairs(&Database::open_read_only(path)?)?),
+    let evidence = match &args.database_path {
+        Some(path) => Some(Evidence::load(&Database::open_read_only(path)?)?),
         None => None,
     };
     let dirs = model_dirs(&args.model)?;
@@ -108,7 +115,7 @@ pub fn run(args: &CheckArgs) -> Result<bool> {
     let mut ghosted = false;
     for (k, dir) in dirs.iter().enumerate() {
         let model = read_sparse_model(dir)?;
-        let result = check::check_model(&model, pairs.as_ref(), &settings)?;
+        let result = check::check_model(&model, evidence.as_ref(), &settings)?;
         println!("{}", verdict_line(dir, &result));
         if let (Some(plots), Some(views)) = (&args.plots, &result.views) {
             std::fs::create_dir_all(plots)

@@ -169,7 +169,7 @@ pub fn run(args: &PruneArgs, quiet: bool, progress: &Progress) -> Result<()> {
     let in_place = args.output.is_none() && !args.dry_run;
     let mut db = args.database.open(!in_place)?;
     let parameters = Parameters::resolve(args.given())?;
-    let overrides = parameters.read_overrides()?;
+    let overrides = parameters.read_overrides(&db)?;
     let stage = |s: &str| progress.stage(s);
     let mut plan = prune::plan(&db, &parameters, &overrides, args.extras(), &stage)?;
     progress.detail(&format!(

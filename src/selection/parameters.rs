@@ -7,6 +7,7 @@
 //! and `export` reads it back to recompute the very costs that drove the selection.
 
 use crate::check;
+use crate::colmap::database::Database;
 use crate::costs::CostModel;
 use crate::flow::search::{Criteria, FlowRule, GivenCriteria};
 use crate::named::Named;
@@ -183,8 +184,8 @@ impl Parameters {
     }
 
     /// The override files named in `arc_rules`, read, and the pairs the model check blames in
-    /// `--model`'s models.
-    pub fn read_overrides(&self) -> Result<Overrides> {
+    /// `--model`'s models (with `db`'s matches).
+    pub fn read_overrides(&self, db: &Database) -> Result<Overrides> {
         let read = |path: &Option<PathBuf>, pairs| {
             path.as_deref()
                 .map(|p| NameList::read(p, pairs))
@@ -192,7 +193,7 @@ impl Parameters {
         };
         let rules = &self.arc_rules;
         let model_conflicts = rules.model.as_deref().map(|dir| {
-            let pairs = check::conflicting_pairs(dir, &check::DEFAULT_SETTINGS)
+            let pairs = check::conflicting_pairs(dir, db, &check::DEFAULT_SETTINGS)
                 .with_context(|| format!("checking --model {}", dir.display()))?;
             let entries = pairs.into_iter().enumerate();
             let entries = entries.map(|(k, [a, b])| (k + 1, vec![a, b])).collect();
