@@ -15,8 +15,9 @@
 #                   imported from there; nothing of it is copied; it has no licence file)
 #   WORKDIR         everything goes here; every step is skipped when its output exists
 #   SCENE           street books cup oats cereal (lab sets: capture order and shuffled ids, seed
-#                   1 as docs/priors.md), duplicate twin symmetric (rendered; 20, 36, 24 images,
-#                   seed 1); default: all
+#                   1 as docs/priors.md), duplicate twin symmetric street-design (rendered,
+#                   `generate images --scene duplicate|twin|symmetric|street`; 20, 36, 24, 20
+#                   images, seed 1); default: all
 # environment: DATASETS (default ../shared/datasets), METHODS (runs mapped by COLMAP 3.8),
 #   GLOBAL_METHODS (runs also mapped by COLMAP 4.2's global mapper), each a space-separated list
 #   of: full disambiguation paper-disambiguation yan-0.30 yan-best cui-0.50 cui-top3 cui-best
@@ -26,14 +27,14 @@
 # Oats: its reference cannot judge the link frames; judge its models (WORKDIR/oats/measure/
 # sparse_*) with scripts/lab/two-copies.py, as lab-summary.py does.
 set -euo pipefail
-[ $# -ge 2 ] || { sed -n '13,27p' "$0" >&2; exit 2; }
+[ $# -ge 2 ] || { sed -n '13,28p' "$0" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/../.." && pwd)
 peers=$(cd "$1" && pwd)
 mkdir -p "$2"
 work=$(cd "$2" && pwd)
 shift 2
 scenes=("$@")
-[ ${#scenes[@]} -gt 0 ] || scenes=(street cup books oats cereal duplicate twin symmetric)
+[ ${#scenes[@]} -gt 0 ] || scenes=(street cup books oats cereal duplicate twin symmetric street-design)
 datasets=${DATASETS:-$here/../shared/datasets}
 all="full disambiguation paper-disambiguation yan-0.30 yan-best cui-0.50 cui-top3 cui-best calibrator"
 methods=${METHODS:-$all}
@@ -92,9 +93,9 @@ for scene in "${scenes[@]}"; do
       ASPECT=4:3 bash "$here/scripts/lab/build-db.sh" "$src" "$dir/order.db"
       [[ $variants == *shuffled* ]] && ASPECT=4:3 bash "$here/scripts/lab/build-db.sh" "$src" "$dir/shuffled.db" 1
       images=$dir/order.db.images ;;
-    duplicate|twin|symmetric)
-      declare -A count=([duplicate]=20 [twin]=36 [symmetric]=24)
-      rendered "$scene" "${count[$scene]}" "$dir"
+    duplicate|twin|symmetric|street-design)
+      declare -A count=([duplicate]=20 [twin]=36 [symmetric]=24 [street-design]=20)
+      rendered "${scene%-design}" "${count[$scene]}" "$dir"
       images=$dir/scene/images
       variants=order
       extra=(--ground_truth "$dir/scene/gt") ;;

@@ -176,11 +176,23 @@ METHODS = {"full": "full database", "disambiguation": "`--preset disambiguation`
            "truth": "true pairs only (bound)"}
 
 
+def database(run):
+    """The database the run's mapper read: recorded by lab-measure.py; runs recorded before it
+    did are named by its layout (pruned_TAG.db beside sparse_TAG, else the variant's database)."""
+    if "database" in run:
+        return run["database"]
+    pruned = run["sparse"].replace(os.sep + "sparse_", os.sep + "pruned_") + ".db"
+    if os.path.exists(pruned):
+        return pruned
+    return os.path.join(os.path.dirname(os.path.dirname(run["sparse"])), run["variant"] + ".db")
+
+
 def check(run):
-    """`vgsel-colmap check`'s verdict on the run's model folder: flagged (exit 3) or clean."""
+    """`vgsel-colmap check`'s verdict on the run's model folder, with its database: flagged
+    (exit 3) or clean."""
     vgsel = os.environ.get("VGSEL", "target/release/vgsel-colmap")
-    status = subprocess.run([vgsel, "check", "--model", run["sparse"]],
-                            capture_output=True).returncode
+    status = subprocess.run([vgsel, "check", "--model", run["sparse"],
+                             "--database_path", database(run)], capture_output=True).returncode
     return {0: "clean", 3: "flagged"}.get(status, f"check error {status}")
 
 

@@ -314,7 +314,7 @@ def scored_run(images, work, dbs, spec):
     uncertain = set(json.load(open(os.path.join(work, "truth.json")))["uncertain"])
     agreed = [i for i in e["images"] if i["name"] not in uncertain]
     result = {"preset": preset, "variant": variant, "order": order, "mapper": kind,
-              "prune_args": " ".join(extra), "sparse": sparse,
+              "prune_args": " ".join(extra), "sparse": sparse, "database": pruned,
               "flow": r and r["flow"],
               "pairs_total": r["pairs_total"] if r else e["pairs"]["used"],
               "pairs_selected": r["pairs_selected"] if r else e["pairs"]["used"],

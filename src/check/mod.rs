@@ -45,6 +45,7 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     conflict: ConflictSettings {
         max_angle_deg: 30.0,
         max_scale: 1.25,
+        occluder: 0.9,
         radius: 0.02,
         min_neighbours: 1,
     },
