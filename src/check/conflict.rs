@@ -19,10 +19,6 @@ pub struct ConflictSettings {
     /// another scale b detects other features there (closer, finer texture; farther, only the
     /// coarse), which is no conflict. The same image of A must pass both tests.
     pub max_scale: f64,
-    /// Nearest distance from b, as a fraction of the point's, of b's structure that may stand
-    /// for the point: b's points nearer than that are in front of it (b sees an occluder there,
-    /// which is no conflict) and are passed over.
-    pub occluder: f64,
     /// Neighbourhood radius around the projection, as a fraction of the image diagonal.
     pub radius: f64,
     /// Triangulated keypoints b needs in the neighbourhood for the sample to count.
@@ -150,12 +146,8 @@ fn judge(
     }
     let at = views.project(b, k)?;
     let radius = views.radius(b, settings.radius);
-    let nearest = settings.occluder * to_b.norm();
     let mut n = 0;
     for j in views.neighbours(b, at, radius) {
-        if (views.points[j] - view.centre).norm() < nearest {
-            continue;
-        }
         if ours(j) {
             return Some(Sample::Agreeing);
         }

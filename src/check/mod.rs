@@ -45,12 +45,11 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     conflict: ConflictSettings {
         max_angle_deg: 30.0,
         max_scale: 1.25,
-        occluder: 0.9,
         radius: 0.02,
         min_neighbours: 1,
     },
     min_group: 3,
-    threshold: 0.4,
+    threshold: 0.48,
     min_conflicts: 30,
     prior: 500,
 };
@@ -79,8 +78,8 @@ pub struct Split {
     pub ratio: f64,
     /// The score: conflicting over judged samples plus [`CheckSettings::prior`].
     pub score: f64,
-    /// Database pairs between the groups, most inliers first (model links where the check ran
-    /// without a database).
+    /// Pairs between the groups, most inliers first: the database's pairs a mapper could use,
+    /// and the pairs that share 3D points in the model (only these without a database).
     pub joining_pairs: Vec<JoiningPair>,
 }
 
@@ -244,7 +243,9 @@ fn describe(
                 Some(p) => p.get(&key).copied().unwrap_or(0),
                 None => 0,
             };
-            if inliers > 0 || (pairs.is_none() && shared > 0) {
+            // Pairs that share points joined the groups in this model, even if the database
+            // invalidated them since (a second `prune --model` must blame them again).
+            if inliers > 0 || shared > 0 {
                 joining.push(JoiningPair {
                     image1: na.clone(),
                     image2: nb.clone(),

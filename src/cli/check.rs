@@ -41,10 +41,6 @@ pub struct CheckArgs {
     /// see what the other saw there.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_scale)]
     max_scale: f64,
-    /// Expert: b's points nearer to b than this fraction of a point's distance are in front of
-    /// it (occluders), never counted for or against it.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.occluder, value_parser = super::args::fraction)]
-    occluder: f64,
     /// Expert: neighbourhood radius around a projected point, as a fraction of the image diagonal.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.radius, value_parser = super::args::fraction)]
     radius: f64,
@@ -65,7 +61,6 @@ impl CheckArgs {
         s.threshold = self.threshold;
         s.conflict.max_angle_deg = self.max_angle;
         s.conflict.max_scale = self.max_scale.max(1.0);
-        s.conflict.occluder = self.occluder;
         s.conflict.radius = self.radius;
         s.min_group = self.min_group.max(1);
         s.min_conflicts = self.min_conflicts;
