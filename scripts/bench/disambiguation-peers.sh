@@ -8,7 +8,8 @@
 # mapper (whose own filtering is the `full` row's global column), judged as the lab measurements
 # judge (scripts/lab/lab-measure.py: the capture-order pseudo ground truth for the lab sets, the
 # true poses for the rendered ones), with the pairs kept against the same labels. Prints one
-# Markdown table (also WORKDIR/table.md). A benchmark, not a test; hours on CPU for every scene.
+# Markdown table (also WORKDIR/table.md), then a summary per method (the README's). A benchmark,
+# not a test; hours on CPU for every scene.
 #
 # usage: scripts/bench/disambiguation-peers.sh PEERS_CHECKOUT WORKDIR [SCENE ...]
 #   PEERS_CHECKOUT  a checkout of cvg/sfm-disambiguation-colmap (its package `disambiguation` is
@@ -124,3 +125,5 @@ for scene in "${scenes[@]}"; do
   "${measure[@]}" "${runs[@]}" >/dev/null
 done
 python3 "$helper" table "$work" "${scenes[@]}" | tee "$work/table.md"
+echo
+python3 "$helper" summary "$work/table.md"

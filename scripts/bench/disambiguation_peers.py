@@ -18,7 +18,11 @@ usage:
   disambiguation_peers.py table WORK SCENE...      (any python 3)
       one Markdown table of every run lab-measure.py has finished in WORK/SCENE/measure, each
       model cell with `vgsel-colmap check`'s verdict on it (VGSEL: the binary,
-      target/release/vgsel-colmap by default): "flagged" when check calls it ghosted.
+      target/release/vgsel-colmap by default): "flagged" when check calls it ghosted. Run with
+      the database each model was mapped from.
+  disambiguation_peers.py summary TABLE.md         (any python 3)
+      per method, from a table the `table` command printed: the cells with one correct model,
+      and the median (over the table's rows) of the false and the true pairs kept.
 
 Settings: the checkout's README and its notebooks for the small yan2017 scenes. Yan: track
 degree 3, coverage 0.9, alpha 0.1, at least 5 shared unique tracks, pairs kept at a score >= 0.3
@@ -32,6 +36,7 @@ then the most true pairs, judged by the same pair labels the table reports.
 import json
 import os
 import shutil
+import statistics
 import subprocess
 import sys
 import types
@@ -244,8 +249,36 @@ def table(work, scenes):
                   f"| {' | '.join(cells)} |")
 
 
+def summary(path):
+    """What a user can expect from each method, from a table `table` printed (PATH): per method,
+    the cells (scene, id order, mapper) with one correct model, and the median over the table's
+    rows of the false and the true pairs kept."""
+    methods, rows = [], {}
+    for line in open(path):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if not line.startswith("| ") or cells[0] == "scene" or len(cells) < 9:
+            continue
+        if cells[2] not in rows:
+            methods.append(cells[2])
+        r = rows.setdefault(cells[2], {"correct": 0, "cells": 0, "false": [], "true": []})
+        for key, cell in (("false", cells[5]), ("true", cells[6])):
+            kept, total = (int(x) for x in cell.split(" of "))
+            r[key].append(kept / total)
+        r["cells"] += 2
+        r["correct"] += sum(c.startswith("**") for c in cells[7:9])
+    cells = max((r["cells"] for r in rows.values()), default=0)
+    print(f"| method | one correct model (of {cells} cells) | false pairs kept (median) "
+          "| true pairs kept (median) |")
+    print("|---|---:|---:|---:|")
+    for m in methods:
+        r = rows[m]
+        print(f"| {m} | {r['correct']} | {100 * statistics.median(r['false']):.0f}% "
+              f"| {100 * statistics.median(r['true']):.0f}% |")
+
+
 def main(argv):
-    commands = {"scores": (scores, 3), "select": (select, 3), "calibrator": (calibrator, 2)}
+    commands = {"scores": (scores, 3), "select": (select, 3), "calibrator": (calibrator, 2),
+                "summary": (summary, 1)}
     if argv and argv[0] == "table" and len(argv) >= 3:
         return table(argv[1], argv[2:])
     if not argv or argv[0] not in commands or len(argv) != commands[argv[0]][1] + 1:

@@ -1,0 +1,38 @@
+"""disambiguation_peers.py summary (scripts/bench): the README's per-method summary of a peers
+table, on a table written here."""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+BENCH = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                     "bench", "disambiguation_peers.py")
+
+TABLE = """\
+| scene | ids | method | threshold | pairs | false kept | true kept | COLMAP 3.8 | COLMAP 4.2 global |
+|---|---|---|---|---|---|---|---|---|
+| a | capture | full database |  | 10 | 4 of 4 | 6 of 6 | 3/5 · flagged | **5/5** · clean |
+| a | capture | ours |  | 5 | 0 of 4 | 3 of 6 | **5/5** · clean | **5/5** · clean |
+| b | capture | full database |  | 20 | 10 of 10 | 10 of 10 | no model | 2/8 (3 reg., 1 model) · clean |
+| b | capture | ours |  | 6 | 1 of 10 | 4 of 10 | **8/8** · clean | 7/8 · clean |
+"""
+
+
+class Summary(unittest.TestCase):
+    def test_counts_correct_cells_and_takes_medians_of_the_rows(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "table.md")
+            with open(path, "w") as f:
+                f.write(TABLE)
+            out = subprocess.run([sys.executable, BENCH, "summary", path], capture_output=True,
+                                 text=True, check=True).stdout.splitlines()
+        self.assertEqual(out[0], "| method | one correct model (of 4 cells) | false pairs kept "
+                                 "(median) | true pairs kept (median) |")
+        self.assertEqual(out[2], "| full database | 1 | 100% | 100% |")
+        # false: 0/4 and 1/10 -> median 5%; true: 3/6 and 4/10 -> 45%
+        self.assertEqual(out[3], "| ours | 3 | 5% | 45% |")
+
+
+if __name__ == "__main__":
+    unittest.main()
