@@ -173,6 +173,7 @@ def calibrator(db, out):
 
 
 METHODS = {"full": "full database", "disambiguation": "`--preset disambiguation`",
+           "repair": "`--preset disambiguation` + repair loop",
            "paper-disambiguation": "`--preset paper-disambiguation`",
            "keep=yan-0.30": "Yan'17, README (0.30)", "keep=yan-best": "Yan'17, best of sweep",
            "keep=cui-0.50": "Cui'15 v2, notebook (0.50)", "keep=cui-top3": "Cui'15 v2, top 3",
@@ -251,8 +252,9 @@ def table(work, scenes):
 
 def summary(path):
     """What a user can expect from each method, from a table `table` printed (PATH): per method,
-    the cells (scene, id order, mapper) with one correct model, and the median over the table's
-    rows of the false and the true pairs kept."""
+    the cells (scene, id order, mapper) with one correct model, the median over the table's
+    rows of the false and the true pairs kept, and the models `check` flagged: correct ones /
+    the others."""
     methods, rows = [], {}
     for line in open(path):
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
@@ -260,20 +262,24 @@ def summary(path):
             continue
         if cells[2] not in rows:
             methods.append(cells[2])
-        r = rows.setdefault(cells[2], {"correct": 0, "cells": 0, "false": [], "true": []})
+        r = rows.setdefault(cells[2], {"correct": 0, "cells": 0, "false": [], "true": [],
+                                       "flagged": [0, 0]})
         for key, cell in (("false", cells[5]), ("true", cells[6])):
             kept, total = (int(x) for x in cell.split(" of "))
             r[key].append(kept / total)
         r["cells"] += 2
         r["correct"] += sum(c.startswith("**") for c in cells[7:9])
+        for c in cells[7:9]:
+            if c.endswith("· flagged"):
+                r["flagged"][0 if c.startswith("**") else 1] += 1
     cells = max((r["cells"] for r in rows.values()), default=0)
     print(f"| method | one correct model (of {cells} cells) | false pairs kept (median) "
-          "| true pairs kept (median) |")
-    print("|---|---:|---:|---:|")
+          "| true pairs kept (median) | `check` flags: correct / other models |")
+    print("|---|---:|---:|---:|---:|")
     for m in methods:
         r = rows[m]
         print(f"| {m} | {r['correct']} | {100 * statistics.median(r['false']):.0f}% "
-              f"| {100 * statistics.median(r['true']):.0f}% |")
+              f"| {100 * statistics.median(r['true']):.0f}% | {r['flagged'][0]} / {r['flagged'][1]} |")
 
 
 def main(argv):

@@ -21,7 +21,10 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             (PRESET `full`: the database unpruned; `truth`: exactly the pairs the reference
             labels true, the best a selection can hand that mapper; `keep=FILE`: exactly the
             verified pairs FILE lists, one `NAME1 NAME2` a line, e.g. another method's
-            selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; --order, default image_id; mapper colmap3.8
+            selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; `repair`:
+            the repair loop after the `disambiguation` run of the same variant, order and mapper:
+            `check` its model, and where it is ghosted `prune --model` it and map once more,
+            else that run stands); --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).
 
@@ -289,6 +292,21 @@ def scored_run(images, work, dbs, spec):
     if os.path.exists(path):
         return json.load(open(path))
     db = dbs[variant]
+    prune_preset, loop = preset, []
+    if preset == "repair":
+        first = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}")
+        # Runs recorded before the database was: pruned_TAG.db beside sparse_TAG.
+        first_db = first.get("database") or first["sparse"].replace(
+            os.sep + "sparse_", os.sep + "pruned_") + ".db"
+        checked = subprocess.run([VGSEL, "check", "--model", first["sparse"], "--database_path",
+                                  first_db], capture_output=True)
+        if checked.returncode not in (0, 3):
+            sys.exit(f"lab-measure: check failed on {first['sparse']}: {checked.stderr.decode()}")
+        if checked.returncode == 0:  # clean: the loop stops at the first model
+            result = dict(first, preset="repair", loop="clean, not repaired")
+            json.dump(result, open(path, "w"), indent=1)
+            return result
+        prune_preset, loop = "disambiguation", ["--model", first["sparse"]]
     if preset == "full":
         pruned, r = db, None
     elif preset == "truth":
@@ -300,7 +318,7 @@ def scored_run(images, work, dbs, spec):
         report = os.path.join(work, f"prune_{tag}.json")
         if not os.path.exists(report):
             run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
-                 "--preset", preset, "--order", order, "--report", report, *extra])
+                 "--preset", prune_preset, "--order", order, "--report", report, *extra, *loop])
         r = json.load(open(report))
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)

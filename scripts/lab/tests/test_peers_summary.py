@@ -28,10 +28,11 @@ class Summary(unittest.TestCase):
             out = subprocess.run([sys.executable, BENCH, "summary", path], capture_output=True,
                                  text=True, check=True).stdout.splitlines()
         self.assertEqual(out[0], "| method | one correct model (of 4 cells) | false pairs kept "
-                                 "(median) | true pairs kept (median) |")
-        self.assertEqual(out[2], "| full database | 1 | 100% | 100% |")
+                                 "(median) | true pairs kept (median) | `check` flags: correct "
+                                 "/ other models |")
+        self.assertEqual(out[2], "| full database | 1 | 100% | 100% | 0 / 1 |")
         # false: 0/4 and 1/10 -> median 5%; true: 3/6 and 4/10 -> 45%
-        self.assertEqual(out[3], "| ours | 3 | 5% | 45% |")
+        self.assertEqual(out[3], "| ours | 3 | 5% | 45% | 0 / 0 |")
 
 
 if __name__ == "__main__":
