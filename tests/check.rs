@@ -49,6 +49,9 @@ fn check_exit_statuses_report_and_plots() {
         plots.to_str().unwrap(),
     ]);
     assert_eq!(out.status.code(), Some(0), "{out:?}");
+    // Without the database, the check says what it cannot tell apart.
+    let note = String::from_utf8(out.stderr).unwrap();
+    assert!(note.contains("without --database_path"), "{note}");
     let line = String::from_utf8(out.stdout).unwrap();
     assert!(line.contains("clean"), "{line}");
     let value: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();

@@ -98,13 +98,19 @@ fn verdict_line(dir: &Path, c: &ModelCheck) -> String {
     line + ")"
 }
 
-/// Runs the check; Ok(true) when some model is ghosted.
-pub fn run(args: &CheckArgs) -> Result<bool> {
+/// Runs the check; Ok(true) when some model is ghosted. `quiet` silences the note on stderr.
+pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     let settings = args.settings();
     let evidence = match &args.database_path {
         Some(path) => Some(Evidence::load(&Database::open_read_only(path)?)?),
         None => None,
     };
+    if evidence.is_none() && !quiet {
+        eprintln!(
+            "vgsel-colmap check: note: without --database_path, a surface that a sparse \
+             selection triangulated twice looks like two copies (docs/check.md)"
+        );
+    }
     let dirs = model_dirs(&args.model)?;
     anyhow::ensure!(
         !dirs.is_empty(),
