@@ -113,8 +113,8 @@ pub struct Views {
     pub seen_by: Vec<Vec<usize>>,
     /// Grid cell size in pixels (the neighbourhood radius).
     pub cell: f64,
-    /// Verified matches between registered views, both ways: (a, b) -> (keypoint of a,
-    /// keypoint of b). Empty without a database.
+    /// Verified matches between registered views a < b: (a, b) -> (keypoint of a, keypoint
+    /// of b). Empty without a database.
     pub matches: HashMap<(usize, usize), Vec<[u32; 2]>>,
 }
 
@@ -207,8 +207,14 @@ impl Views {
             xy.is_some_and(|xy| (xy[0] - to[0]).hypot(xy[1] - to[1]) <= r)
         };
         let (ka, kb) = (&self.views[a].keypoints, &self.views[b].keypoints);
-        self.matches.get(&(a, b)).is_some_and(|m| {
-            m.iter().any(|&[x, y]| {
+        let (key, swap) = if a < b {
+            ((a, b), false)
+        } else {
+            ((b, a), true)
+        };
+        self.matches.get(&key).is_some_and(|m| {
+            m.iter().any(|&m| {
+                let [x, y] = if swap { [m[1], m[0]] } else { m };
                 near(kb.get(y as usize), at, radius_b) && near(ka.get(x as usize), from, radius_a)
             })
         })
@@ -249,7 +255,7 @@ impl Views {
     }
 }
 
-/// The evidence's matches between registered views, by view index, both ways.
+/// The evidence's matches between registered views, by view indices a < b.
 fn view_matches(views: &[View], evidence: &Evidence) -> HashMap<(usize, usize), Vec<[u32; 2]>> {
     let index: HashMap<&str, usize> = views
         .iter()
@@ -259,8 +265,12 @@ fn view_matches(views: &[View], evidence: &Evidence) -> HashMap<(usize, usize), 
     let mut out = HashMap::new();
     for ((n1, n2), m) in &evidence.matches {
         if let (Some(&a), Some(&b)) = (index.get(n1.as_str()), index.get(n2.as_str())) {
-            out.insert((b, a), m.iter().map(|&[x, y]| [y, x]).collect());
-            out.insert((a, b), m.clone());
+            let oriented = if a < b {
+                m.clone()
+            } else {
+                m.iter().map(|&[x, y]| [y, x]).collect()
+            };
+            out.insert((a.min(b), a.max(b)), oriented);
         }
     }
     out
