@@ -203,9 +203,7 @@ fn candidates(
     let mut out = splits::candidate_splits(n, &splits::spanning_tree(n, links), min);
     let tree = splits::candidate_splits(n, &splits::spanning_tree(n, consistent), min);
     for side in tree.into_iter().chain(spectral).chain(components) {
-        if !out.contains(&side) {
-            out.push(side);
-        }
+        splits::push_split(&mut out, side);
     }
     out
 }

@@ -96,15 +96,23 @@ pub fn candidate_splits(n: usize, tree: &[(usize, usize)], min_group: usize) -> 
                 }
             }
         }
-        if side[0] {
-            side.iter_mut().for_each(|s| *s = !*s);
-        }
         let b = side.iter().filter(|s| **s).count();
-        if b >= min_group && n - b >= min_group && !out.contains(&side) {
-            out.push(side);
+        if b >= min_group && n - b >= min_group {
+            push_split(&mut out, side);
         }
     }
     out
+}
+
+/// Adds `side` to `out` unless it is there already, in the one form every split is kept in:
+/// the model's first image in the `false` group, so that a split and its mirror are one.
+pub fn push_split(out: &mut Vec<Vec<bool>>, mut side: Vec<bool>) {
+    if side[0] {
+        side.iter_mut().for_each(|s| *s = !*s);
+    }
+    if !out.contains(&side) {
+        out.push(side);
+    }
 }
 
 /// The sweep cuts of the graph's spectral embedding: images ordered by the Fiedler vector of
@@ -143,12 +151,7 @@ pub fn spectral_splits(
     for k in min_group..=n - min_group {
         let mut side = vec![false; n];
         by_value[k..].iter().for_each(|&v| side[v] = true);
-        if side[0] {
-            side.iter_mut().for_each(|s| *s = !*s);
-        }
-        if !out.contains(&side) {
-            out.push(side);
-        }
+        push_split(&mut out, side);
     }
     out
 }
@@ -170,16 +173,10 @@ pub fn component_splits(
     let roots: Vec<usize> = (0..n).map(|v| sets.find(v)).collect();
     let mut out = Vec::new();
     for root in 0..n {
-        let mut side: Vec<bool> = roots.iter().map(|&r| r == root).collect();
+        let side: Vec<bool> = roots.iter().map(|&r| r == root).collect();
         let size = side.iter().filter(|s| **s).count();
-        if size < min_group || n - size < min_group {
-            continue;
-        }
-        if side[0] {
-            side.iter_mut().for_each(|s| *s = !*s);
-        }
-        if !out.contains(&side) {
-            out.push(side);
+        if size >= min_group && n - size >= min_group {
+            push_split(&mut out, side);
         }
     }
     out
