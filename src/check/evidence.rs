@@ -42,25 +42,22 @@ impl Evidence {
             })
         };
         let invalid: HashSet<u64> = db.invalidated_pair_ids()?;
-        let mut pairs = BTreeMap::new();
-        for g in db.geometries()? {
-            let id = crate::colmap::ids::pair_id(g.image_id1, g.image_id2);
-            if let (false, Some((key, _))) =
-                (invalid.contains(&id), ordered(g.image_id1, g.image_id2))
-            {
-                pairs.insert(key, g.num_inliers);
-            }
-        }
-        let mut matches = BTreeMap::new();
+        let (mut pairs, mut matches) = (BTreeMap::new(), BTreeMap::new());
+        // One read of two_view_geometries: each row's inliers are its matches, and their count
+        // is the pair's inliers (rows).
         for p in db.verified_pairs()? {
-            if let Some((key, swapped)) = ordered(p.image_id1, p.image_id2) {
-                let inliers = if swapped {
-                    p.inliers.iter().map(|m| [m[1], m[0]]).collect()
-                } else {
-                    p.inliers
-                };
-                matches.insert(key, inliers);
+            let Some((key, swapped)) = ordered(p.image_id1, p.image_id2) else {
+                continue;
+            };
+            if !invalid.contains(&crate::colmap::ids::pair_id(p.image_id1, p.image_id2)) {
+                pairs.insert(key.clone(), p.inliers.len());
             }
+            let inliers = if swapped {
+                p.inliers.iter().map(|m| [m[1], m[0]]).collect()
+            } else {
+                p.inliers
+            };
+            matches.insert(key, inliers);
         }
         Ok(Evidence { pairs, matches })
     }
