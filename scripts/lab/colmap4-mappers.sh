@@ -11,15 +11,9 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 work=${1:-target/colmap4-mappers}
 runs=${2:-5}
-bin=${VGSEL:-target/release/vgsel-colmap}
-[ -x "$bin" ] || cargo build --release --quiet
-PY=$(bash scripts/ci/pycolmap-venv.sh)
 # shellcheck source=scripts/lab/demo-matching.sh
 source scripts/lab/demo-matching.sh
-rm -rf "$work"
-mkdir -p "$work"
-"$bin" generate images --scene duplicate --num_images 20 --seed 1 --output "$work/scene" -q
-images=$work/scene/images
+demo_setup "$work"
 for run in $(seq 1 "$runs"); do
   for matcher in colmap3.8 pycolmap4.2; do
     dir=$work/$run/$matcher

@@ -1,7 +1,24 @@
-# Sourced by the demo-scene measurements (colmap4-mappers.sh, repair-loop.sh): one fresh matching
-# of the demo's 20 rendered images into DIR/full.db, by COLMAP 3.8 or by pycolmap 4.2 (PY, from
-# scripts/ci/pycolmap-venv.sh), 1024 SIFT features, the renderer's intrinsics given.
-# usage: match_demo MATCHER IMAGES DIR   (MATCHER: colmap3.8 | pycolmap4.2)
+# Sourced by the demo-scene measurements (colmap4-mappers.sh, repair-loop.sh), from the
+# repository's root: their common set-up, and one fresh matching of the demo's 20 rendered images
+# into DIR/full.db, by COLMAP 3.8 or by pycolmap 4.2 (PY), 1024 SIFT features, the renderer's
+# intrinsics given.
+# usage: demo_setup WORK                 (sets bin, PY and images)
+#        match_demo MATCHER IMAGES DIR   (MATCHER: colmap3.8 | pycolmap4.2)
+
+# The binary (VGSEL, else target/release/vgsel-colmap, built if missing) as bin, pycolmap's python
+# (scripts/ci/pycolmap-venv.sh) as PY, and WORK emptied with the demo scene rendered into
+# WORK/scene (its images: images).
+demo_setup() {
+  local work=$1
+  bin=${VGSEL:-target/release/vgsel-colmap}
+  [ -x "$bin" ] || cargo build --release --quiet
+  PY=$(bash scripts/ci/pycolmap-venv.sh)
+  rm -rf "$work"
+  mkdir -p "$work"
+  "$bin" generate images --scene duplicate --num_images 20 --seed 1 --output "$work/scene" -q
+  images=$work/scene/images
+}
+
 match_demo() {
   local matcher=$1 images=$2 dir=$3 params=400,240,180,0
   if [ "$matcher" = colmap3.8 ]; then

@@ -11,15 +11,9 @@ cd "$(dirname "$0")/../.."
 work=${1:-target/repair-loop}
 runs=${2:-5}
 mappers=${3:-global incremental}
-bin=${VGSEL:-target/release/vgsel-colmap}
-[ -x "$bin" ] || cargo build --release --quiet
-PY=$(bash scripts/ci/pycolmap-venv.sh)
 # shellcheck source=scripts/lab/demo-matching.sh
 source scripts/lab/demo-matching.sh
-rm -rf "$work"
-mkdir -p "$work"
-"$bin" generate images --scene duplicate --num_images 20 --seed 1 --output "$work/scene" -q
-images=$work/scene/images
+demo_setup "$work"
 score() { # MODEL DB -> correct/registered/models as JSON
   "$bin" eval --model "$1" --ground_truth "$work/scene/gt" --database_path "$2" --baseline "$dir/full.db"
 }
