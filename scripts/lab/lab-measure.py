@@ -289,17 +289,18 @@ def scored_run(images, work, dbs, spec):
     if extra:
         tag += "_" + hashlib.sha1(" ".join(extra).encode()).hexdigest()[:8]
     path = os.path.join(work, f"run_{tag}.json")
-    if os.path.exists(path):
-        return json.load(open(path))
     db = dbs[variant]
+    if os.path.exists(path):
+        result = json.load(open(path))
+        # Runs recorded before the database was: the variant's own, or pruned_TAG.db.
+        result.setdefault("database",
+                          db if preset == "full" else os.path.join(work, f"pruned_{tag}.db"))
+        return result
     prune_preset, loop = preset, []
     if preset == "repair":
         first = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}")
-        # Runs recorded before the database was: pruned_TAG.db beside sparse_TAG.
-        first_db = first.get("database") or first["sparse"].replace(
-            os.sep + "sparse_", os.sep + "pruned_") + ".db"
         checked = subprocess.run([VGSEL, "check", "--model", first["sparse"], "--database_path",
-                                  first_db], capture_output=True)
+                                  first["database"]], capture_output=True)
         if checked.returncode not in (0, 3):
             sys.exit(f"lab-measure: check failed on {first['sparse']}: {checked.stderr.decode()}")
         if checked.returncode == 0:  # clean: the loop stops at the first model
