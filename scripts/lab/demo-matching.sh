@@ -1,13 +1,14 @@
 # Sourced by the demo-scene measurements (colmap4-mappers.sh, repair-loop.sh), from the
 # repository's root: their common set-up, and one fresh matching of the demo's 20 rendered images
 # into DIR/full.db, by COLMAP 3.8 or by pycolmap 4.2 (PY), 1024 SIFT features, the renderer's
-# intrinsics given.
-# usage: demo_setup WORK                 (sets bin, PY and images)
+# intrinsics given. SCENE, NUM_IMAGES and SEED (default duplicate, 20, 1: the demo) render
+# another design instead, to judge on scenes the measurements were not tuned on.
+# usage: demo_setup WORK                 (sets bin, PY, images and num_images)
 #        match_demo MATCHER IMAGES DIR   (MATCHER: colmap3.8 | pycolmap4.2)
 
 # The binary (VGSEL, else target/release/vgsel-colmap, built if missing) as bin, pycolmap's python
-# (scripts/ci/pycolmap-venv.sh) as PY, and WORK emptied with the demo scene rendered into
-# WORK/scene (its images: images).
+# (scripts/ci/pycolmap-venv.sh) as PY, and WORK emptied with the scene rendered into WORK/scene
+# (its images: images; their number: num_images).
 demo_setup() {
   local work=$1
   bin=${VGSEL:-target/release/vgsel-colmap}
@@ -15,7 +16,9 @@ demo_setup() {
   PY=$(bash scripts/ci/pycolmap-venv.sh)
   rm -rf "$work"
   mkdir -p "$work"
-  "$bin" generate images --scene duplicate --num_images 20 --seed 1 --output "$work/scene" -q
+  num_images=${NUM_IMAGES:-20}
+  "$bin" generate images --scene "${SCENE:-duplicate}" --num_images "$num_images" \
+    --seed "${SEED:-1}" --output "$work/scene" -q
   images=$work/scene/images
 }
 
