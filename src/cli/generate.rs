@@ -53,6 +53,8 @@ enum SceneArg {
     Symmetric,
     /// A row of identical buildings walked past by cameras translating along it.
     Street,
+    /// Two identical objects in differently textured halves of a room, each orbited all round.
+    Hall,
 }
 
 #[derive(Args)]
@@ -106,6 +108,7 @@ pub fn run(command: &GenerateCommand) -> Result<()> {
                 SceneArg::Twin => render::SceneKind::Twin,
                 SceneArg::Symmetric => render::SceneKind::Symmetric,
                 SceneArg::Street => render::SceneKind::Street,
+                SceneArg::Hall => render::SceneKind::Hall,
             };
             render::Scene::build(kind, args.num_images, args.seed)
                 .and_then(|scene| scene.write(&args.output))

@@ -57,6 +57,11 @@ pub enum SceneKind {
     /// match copy to copy, and as the translation runs along the repetition those matches fit
     /// the true epipolar geometry with rays that meet in front of both cameras.
     Street,
+    /// The duplicate's room and objects, each object orbited all round (as the twin's, but
+    /// indoors: every view has walls behind its object, and the halves' walls differ), the two
+    /// orbits linked by a short walk along the room's side; in capture order (first orbit,
+    /// walk, second orbit). Views of the two objects from the same side match copy to copy.
+    Hall,
 }
 
 /// Distance in metres from one building of the street to the next (3 m wide, 2 m gaps).
@@ -362,17 +367,21 @@ fn symmetric(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAi
     (cuboids, poses)
 }
 
-/// [`SceneKind::Duplicate`]: its boxes and `num_images` cameras.
-fn duplicate(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
-    let (mut cuboids, mut poses) = (Vec::new(), Vec::new());
-    // A long room whose halves (x < 0, x > 0) have their own wall textures; the same
-    // object stands in the middle of each half.
+/// The duplicate's and the hall's boxes: a long room whose halves (x < 0, x > 0) have their own
+/// wall textures, the same object in the middle of each half.
+fn two_halves(draws: &mut Draws) -> Vec<Cuboid> {
     let mut room = Cuboid::new([-10.0, -4.0, 0.0], [10.0, 4.0, 3.5], draws.tex());
     room.east = draws.tex();
     room.inside = true;
-    cuboids.push(room);
+    let mut cuboids = vec![room];
     cuboids.extend(draws.object(-5.0, 0.0));
     cuboids.extend(draws.object(5.0, 0.0));
+    cuboids
+}
+
+/// [`SceneKind::Duplicate`]: its boxes and `num_images` cameras.
+fn duplicate(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let (cuboids, mut poses) = (two_halves(draws), Vec::new());
     let walk = (num_images / 4).max(2);
     let per_orbit = (num_images - walk) / 2;
     // Half orbits on the walk's side, so the walk sees what the orbits see.
@@ -389,6 +398,23 @@ fn duplicate(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAi
         let centre = Vector3::new(x, -3.5, 1.6) + draws.jitter(0.2);
         poses.push((centre, Vector3::new(x, 4.0, 1.2) + draws.jitter(0.4)));
     }
+    (cuboids, poses)
+}
+
+/// [`SceneKind::Hall`]: its boxes and `num_images` cameras.
+fn hall(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let (cuboids, mut poses) = (two_halves(draws), Vec::new());
+    let walk = (num_images / 8).max(2);
+    let per_orbit = (num_images - walk) / 2;
+    draws.orbit(&mut poses, -5.0, per_orbit, 0.0, TAU);
+    // The walk along the room's -y side, looking across it, from the first object's orbit to
+    // the second's; the second orbit starts on the side the walk ends on.
+    for k in 0..walk {
+        let x = -3.0 + 6.0 * k as f64 / (walk - 1) as f64;
+        let centre = Vector3::new(x, -3.2, 1.6) + draws.jitter(0.2);
+        poses.push((centre, Vector3::new(1.5 * x, 0.0, 0.8) + draws.jitter(0.4)));
+    }
+    draws.orbit(&mut poses, 5.0, num_images - walk - per_orbit, 1.5 * PI, TAU);
     (cuboids, poses)
 }
 
@@ -469,6 +495,7 @@ impl Scene {
             SceneKind::Symmetric => symmetric(&mut draws, num_images),
             SceneKind::Duplicate => duplicate(&mut draws, num_images),
             SceneKind::Street => street(&mut draws, num_images),
+            SceneKind::Hall => hall(&mut draws, num_images),
         };
         Ok(Scene {
             cuboids,
@@ -736,6 +763,29 @@ mod tests {
         for w in links.windows(2) {
             assert!((w[1].centre - w[0].centre).norm() < 3.5);
         }
+    }
+
+    /// The hall's objects are identical, the room's halves are not, and its orbits go all round
+    /// their own object, in capture order: first orbit, walk, second orbit.
+    #[test]
+    fn hall_orbits_go_round_identical_objects_in_different_halves() {
+        let scene = Scene::build(SceneKind::Hall, 38, 1).unwrap();
+        let (room, a, b) = (&scene.cuboids[0], &scene.cuboids[1], &scene.cuboids[3]);
+        assert_eq!(a.faces, b.faces);
+        assert_ne!(room.faces, room.east);
+        assert_eq!(b.min - a.min, Vector3::new(10.0, 0.0, 0.0));
+        let centres: Vec<_> = scene.truth.images.iter().map(|im| im.centre).collect();
+        let round = |orbit: &[Vector3<f64>], x: f64| {
+            let mut seen = [false; 4];
+            for c in orbit {
+                assert!(((c.x - x).hypot(c.y) - 2.8).abs() < 0.3);
+                let quadrant = (c.y.atan2(c.x - x) + PI) / (PI / 2.0);
+                seen[(quadrant as usize).min(3)] = true;
+            }
+            seen.iter().all(|&s| s)
+        };
+        assert!(round(&centres[..17], -5.0) && round(&centres[21..], 5.0));
+        assert!(centres[17..21].iter().all(|c| (c.y + 3.2).abs() < 0.2));
     }
 
     /// The street's buildings are copies a period apart, and the cameras walk along the row.
