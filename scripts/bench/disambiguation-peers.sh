@@ -16,9 +16,9 @@
 #                   imported from there; nothing of it is copied; it has no licence file)
 #   WORKDIR         everything goes here; every step is skipped when its output exists
 #   SCENE           street books cup oats cereal (lab sets: capture order and shuffled ids, seed
-#                   1 as docs/priors.md), duplicate twin symmetric street-design (rendered,
-#                   `generate images --scene duplicate|twin|symmetric|street`; 20, 36, 24, 20
-#                   images, seed 1); default: all
+#                   1 as docs/priors.md), duplicate twin symmetric street-design hall (rendered,
+#                   `generate images --scene duplicate|twin|symmetric|street|hall`; 20, 36, 24,
+#                   20, 38 images, seed 1); default: all
 # environment: DATASETS (default ../shared/datasets), METHODS (runs mapped by COLMAP 3.8),
 #   GLOBAL_METHODS (runs also mapped by COLMAP 4.2's global mapper), each a space-separated list
 #   of: full disambiguation repair (the repair loop after disambiguation: check, prune --model,
@@ -37,7 +37,7 @@ mkdir -p "$2"
 work=$(cd "$2" && pwd)
 shift 2
 scenes=("$@")
-[ ${#scenes[@]} -gt 0 ] || scenes=(street cup books oats cereal duplicate twin symmetric street-design)
+[ ${#scenes[@]} -gt 0 ] || scenes=(street cup books oats cereal duplicate twin symmetric street-design hall)
 datasets=${DATASETS:-$here/../shared/datasets}
 all="full disambiguation repair paper-disambiguation yan-0.30 yan-best cui-0.50 cui-top3 cui-best calibrator"
 methods=${METHODS:-$all}
@@ -96,8 +96,8 @@ for scene in "${scenes[@]}"; do
       ASPECT=4:3 bash "$here/scripts/lab/build-db.sh" "$src" "$dir/order.db"
       [[ $variants == *shuffled* ]] && ASPECT=4:3 bash "$here/scripts/lab/build-db.sh" "$src" "$dir/shuffled.db" 1
       images=$dir/order.db.images ;;
-    duplicate|twin|symmetric|street-design)
-      declare -A count=([duplicate]=20 [twin]=36 [symmetric]=24 [street-design]=20)
+    duplicate|twin|symmetric|street-design|hall)
+      declare -A count=([duplicate]=20 [twin]=36 [symmetric]=24 [street-design]=20 [hall]=38)
       rendered "${scene%-design}" "${count[$scene]}" "$dir"
       images=$dir/scene/images
       variants=order
