@@ -61,9 +61,10 @@ pub struct PruneArgs {
     forbid_images: Option<PathBuf>,
     /// A mapper's output on this database (a model folder or its output_path), for the repair
     /// loop: the pairs that glued a model `check` finds ghosted are never selected
-    /// (docs/check.md).
+    /// (docs/check.md). Repeat it with every earlier turn's output, so that no turn selects again
+    /// what an earlier one blamed.
     #[arg(long, value_name = "DIR", help_heading = SELECT)]
-    model: Option<PathBuf>,
+    model: Vec<PathBuf>,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
     #[arg(long, default_value_t = DEFAULT_MIN_NUM_MATCHES, help_heading = SELECT)]
     min_num_matches: usize,

@@ -41,9 +41,9 @@ pub struct ArcRules {
     pub forbid_pairs: Option<PathBuf>,
     /// `--forbid_images`: the file of images never selected.
     pub forbid_images: Option<PathBuf>,
-    /// `--model`: a mapper's output on this database; the pairs that glued a model the check
-    /// finds ghosted are never selected.
-    pub model: Option<PathBuf>,
+    /// `--model`: mappers' outputs on this database; the pairs that glued a model the check
+    /// finds ghosted, in any of them, are never selected.
+    pub model: Vec<PathBuf>,
 }
 
 /// One list file as read: each entry with its 1-based line number.
@@ -98,9 +98,9 @@ pub struct Overrides {
     pub forbid_pairs: Option<NameList>,
     /// `--forbid_images`: images taken out of the network with all their pairs.
     pub forbid_images: Option<NameList>,
-    /// `--model`: the pairs the model check blames, never selected (a pair list whose path is
-    /// the model folder).
-    pub model_conflicts: Option<NameList>,
+    /// `--model`: the pairs the model check blames, never selected (a pair list per folder,
+    /// whose path is the folder).
+    pub model_conflicts: Vec<NameList>,
 }
 
 /// The overrides as listed in the report, by image name.
@@ -154,8 +154,8 @@ impl Overrides {
         if let Some(list) = &self.forbid_pairs {
             resolved.forbid_pairs(list, &names)?;
         }
-        if let Some(list) = &self.model_conflicts {
-            resolved.forbid_model_conflicts(list, &names)?;
+        if !self.model_conflicts.is_empty() {
+            resolved.forbid_model_conflicts(&self.model_conflicts, &names)?;
         }
         if let Some(list) = &self.keep_pairs {
             resolved.keep_pairs(list, &names, min_num_matches)?;
@@ -253,14 +253,20 @@ impl Resolved {
         Ok(())
     }
 
-    /// `--model`: the pairs the model check blames leave the network (those that are edges).
-    fn forbid_model_conflicts(&mut self, list: &NameList, names: &Names) -> Result<()> {
-        let mut blamed = Vec::new();
-        for (line, entry) in &list.entries {
-            if let Some(k) = names.edge(list, *line, entry)? {
-                self.edges[k] = ArcRule::Removed;
+    /// `--model`: the pairs the model check blames in any folder leave the network (those that
+    /// are edges); listed once each, in the order first blamed.
+    fn forbid_model_conflicts(&mut self, lists: &[NameList], names: &Names) -> Result<()> {
+        let (mut blamed, mut seen) = (Vec::new(), std::collections::BTreeSet::new());
+        for list in lists {
+            for (line, entry) in &list.entries {
+                if let Some(k) = names.edge(list, *line, entry)? {
+                    self.edges[k] = ArcRule::Removed;
+                }
+                let pair = [entry[0].clone(), entry[1].clone()];
+                if seen.insert(pair.clone()) {
+                    blamed.push(pair);
+                }
             }
-            blamed.push([entry[0].clone(), entry[1].clone()]);
         }
         self.listed.model_conflicts = Some(blamed);
         Ok(())
@@ -368,29 +374,36 @@ mod tests {
     use crate::flow::search::Criteria;
     use crate::scene::testing::{images, pair};
 
-    /// The model check's pairs leave the network like forbidden pairs, and are listed; a
-    /// blamed pair that is no view-graph edge is listed and changes nothing.
+    /// The model check's pairs leave the network like forbidden pairs, and are listed once
+    /// each whichever folders blamed them; a blamed pair that is no view-graph edge is listed and
+    /// changes nothing.
     #[test]
     fn pairs_the_model_check_blames_are_never_selected() {
         let images = images(4);
         let pairs: Vec<VerifiedPair> = (1..4).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
         let graph = ViewGraph::build(&images, &pairs, 15);
         let name = |id: u32| images[id as usize - 1].name.clone();
-        let list = NameList {
-            path: PathBuf::from("sparse"),
-            entries: vec![(1, vec![name(2), name(3)]), (2, vec![name(1), name(4)])],
+        let list = |path: &str, entries: Vec<Vec<String>>| NameList {
+            path: PathBuf::from(path),
+            entries: entries.into_iter().enumerate().map(|(k, e)| (k + 1, e)).collect(),
         };
         let overrides = Overrides {
-            model_conflicts: Some(list),
+            model_conflicts: vec![
+                list("sparse", vec![vec![name(2), name(3)], vec![name(1), name(4)]]),
+                list("sparse2", vec![vec![name(1), name(4)], vec![name(3), name(4)]]),
+            ],
             ..Overrides::default()
         };
         let resolved = overrides.resolve(&images, &graph, 15).unwrap();
         assert_eq!(
             resolved.edges,
-            [ArcRule::Free, ArcRule::Removed, ArcRule::Free]
+            [ArcRule::Free, ArcRule::Removed, ArcRule::Removed]
         );
         let listed = resolved.listed.model_conflicts.unwrap();
-        assert_eq!(listed, [[name(2), name(3)], [name(1), name(4)]]);
+        assert_eq!(
+            listed,
+            [[name(2), name(3)], [name(1), name(4)], [name(3), name(4)]]
+        );
         assert!(Overrides::default()
             .resolve(&images, &graph, 15)
             .unwrap()

@@ -60,8 +60,8 @@ pub struct Given {
     pub forbid_pairs: Option<PathBuf>,
     /// `--forbid_images`.
     pub forbid_images: Option<PathBuf>,
-    /// `--model`.
-    pub model: Option<PathBuf>,
+    /// `--model`, each time it is given.
+    pub model: Vec<PathBuf>,
 }
 
 /// Everything that decides a selection, besides the database.
@@ -192,7 +192,7 @@ impl Parameters {
                 .transpose()
         };
         let rules = &self.arc_rules;
-        let model_conflicts = rules.model.as_deref().map(|dir| {
+        let model_conflicts = rules.model.iter().map(|dir| {
             let pairs = check::conflicting_pairs(dir, db, &check::DEFAULT_SETTINGS)
                 .with_context(|| format!("checking --model {}", dir.display()))?;
             let entries = pairs.into_iter().enumerate();
@@ -206,7 +206,7 @@ impl Parameters {
             keep_pairs: read(&rules.keep_pairs, true)?,
             forbid_pairs: read(&rules.forbid_pairs, true)?,
             forbid_images: read(&rules.forbid_images, false)?,
-            model_conflicts: model_conflicts.transpose()?,
+            model_conflicts: model_conflicts.collect::<Result<_>>()?,
         })
     }
 }
@@ -245,8 +245,27 @@ struct Recorded {
     keep_pairs: Option<String>,
     forbid_pairs: Option<String>,
     forbid_images: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    model: Option<String>,
+    /// One folder was recorded as a string before `--model` could be repeated.
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "one_or_more"
+    )]
+    model: Vec<String>,
+}
+
+/// A recorded `model`: a list, or one string as recorded before `--model` could be repeated.
+fn one_or_more<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<String>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMore {
+        One(String),
+        More(Vec<String>),
+    }
+    Ok(match OneOrMore::deserialize(d)? {
+        OneOrMore::One(dir) => vec![dir],
+        OneOrMore::More(dirs) => dirs,
+    })
 }
 
 impl From<Parameters> for Recorded {
@@ -279,7 +298,9 @@ impl From<Parameters> for Recorded {
             keep_pairs: text(p.arc_rules.keep_pairs),
             forbid_pairs: text(p.arc_rules.forbid_pairs),
             forbid_images: text(p.arc_rules.forbid_images),
-            model: text(p.arc_rules.model),
+            model: (p.arc_rules.model.iter())
+                .map(|dir| dir.display().to_string())
+                .collect(),
         }
     }
 }
@@ -319,7 +340,7 @@ impl From<Recorded> for Parameters {
                 keep_pairs: r.keep_pairs.map(PathBuf::from),
                 forbid_pairs: r.forbid_pairs.map(PathBuf::from),
                 forbid_images: r.forbid_images.map(PathBuf::from),
-                model: r.model.map(PathBuf::from),
+                model: r.model.into_iter().map(PathBuf::from).collect(),
             },
         }
     }
@@ -368,6 +389,25 @@ mod tests {
         assert_eq!(oldest.flow, Flow::Searched(expected));
         assert_eq!(oldest.capture, capture_order::Input::default());
         assert_eq!(oldest.cost_model, Preset::General.defaults().cost_model);
+    }
+
+    /// `model` was one folder's string before `--model` could be repeated: such a record loads
+    /// as that one folder, and today's list of folders reads back as written.
+    #[test]
+    fn recorded_model_folders_load_from_one_string_or_a_list() {
+        let path = format!(
+            "{}/fixtures/runs/disambiguation-sequence.json",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let mut recorded: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        recorded["model"] = "sparse".into();
+        let one: Parameters = serde_json::from_value(recorded.clone()).unwrap();
+        assert_eq!(one.arc_rules.model, [PathBuf::from("sparse")]);
+        recorded["model"] = serde_json::json!(["sparse", "sparse2"]);
+        let two: Parameters = serde_json::from_value(recorded.clone()).unwrap();
+        assert_eq!(two.arc_rules.model.len(), 2);
+        assert_eq!(serde_json::to_value(&two).unwrap(), recorded);
     }
 
     /// The preset fills exactly what the user left unset.
