@@ -16,9 +16,9 @@
 #   CAMERA_MODEL    [SIMPLE_RADIAL]              CAMERA_PARAMS known intrinsics, e.g. "f,cx,cy" []
 #   SINGLE_CAMERA   one camera for all images [1]
 #   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
-#   REPAIR          1: the repair loop (docs/check.md): `vgsel-colmap check` on the pruned
-#                   model, and where it says ghosted, `prune --model` on it and one more mapper
-#                   run, a third row `repaired` [0]
+#   REPAIR          N > 0: the repair loop (docs/check.md), at most N turns: `vgsel-colmap
+#                   check` on the last model, and where it says ghosted, `prune --model` with
+#                   every model so far and one more mapper run, a row `repairedK` per turn [0]
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -86,27 +86,30 @@ map_and_eval() {
 }
 map_and_eval full
 map_and_eval pruned
-rm -f "$work/eval_repaired.json" "$work/sparse_repaired.seconds"
-if [ "${REPAIR:-0}" = 1 ]; then
+rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds
+last=pruned models=()
+for turn in $(seq 1 "${REPAIR:-0}"); do
   status=0
-  "$bin" check --model "$work/sparse_pruned" --database_path "$work/pruned.db" \
-    --report "$work/check_pruned.json" >&2 || status=$?
-  if [ "$status" = 3 ]; then
-    log "the pruned model is ghosted: prune --model, mapper again"
-    # shellcheck disable=SC2086
-    "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired.db" --overwrite \
-      --report "$work/prune_repaired.json" --model "$work/sparse_pruned" $prune_args
-    map_and_eval repaired
-  elif [ "$status" != 0 ]; then
-    exit "$status"
-  fi
-fi
+  "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" \
+    --report "$work/check_$last.json" >&2 || status=$?
+  [ "$status" = 0 ] && break
+  [ "$status" = 3 ] || exit "$status"
+  models+=(--model "$work/sparse_$last")
+  log "the $last model is ghosted: prune --model (turn $turn), mapper again"
+  # shellcheck disable=SC2086
+  "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
+    --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args
+  map_and_eval "repaired$turn"
+  last=repaired$turn
+done
 
 python3 - "$work" "$t_extract" "$t_match" <<'EOF'
-import json, sys
+import json, os, sys
 work, t_extract, t_match = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
 rows = {}
-for v in ("full", "pruned", "repaired"):
+turns = sorted(int(f[len("eval_repaired"):-5]) for f in os.listdir(work)
+               if f.startswith("eval_repaired") and f.endswith(".json"))
+for v in ["full", "pruned"] + [f"repaired{k}" for k in turns]:
     try:
         e = json.load(open(f"{work}/eval_{v}.json"))
     except FileNotFoundError:
@@ -114,11 +117,11 @@ for v in ("full", "pruned", "repaired"):
     e["mapper_seconds"] = float(open(f"{work}/sparse_{v}.seconds").read())
     rows[v] = e
 fmt = lambda x, f: "-" if x is None else f % x
-print(f"{'database':<8} {'pairs':>6} {'mapper s':>9} {'models':>6} {'registered':>10} "
+print(f"{'database':<10} {'pairs':>6} {'mapper s':>9} {'models':>6} {'registered':>10} "
       f"{'correct':>7} {'med. pos':>9} {'med. rot':>9} {'false pairs':>11}")
 for v, e in rows.items():
     p = e.get("pairs") or {}
-    print(f"{v:<8} {e['pairs_used']:>6} {e['mapper_seconds']:>9.1f} {e['models']:>6} "
+    print(f"{v:<10} {e['pairs_used']:>6} {e['mapper_seconds']:>9.1f} {e['models']:>6} "
           f"{str(e['registered']) + '/' + str(e['images_total']):>10} "
           f"{fmt(e.get('correct'), '%d'):>7} {fmt(e.get('median_position_error'), '%.4f'):>9} "
           f"{fmt(e.get('median_rotation_error_deg'), '%.2f°'):>9} {fmt(p.get('false'), '%d'):>11}")

@@ -252,9 +252,10 @@ def table(work, scenes):
 
 def summary(path):
     """What a user can expect from each method, from a table `table` printed (PATH): per method,
-    the cells (scene, id order, mapper) with one correct model, the median over the table's
-    rows of the false and the true pairs kept, and the models `check` flagged: correct ones /
-    the others."""
+    the cells (scene, id order, mapper) with one correct model, those where every camera is
+    correct in however many models (ghost-free, maybe split), the median over the table's rows
+    of the false and the true pairs kept, and the models `check` flagged: correct ones / the
+    others."""
     methods, rows = [], {}
     for line in open(path):
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
@@ -262,23 +263,27 @@ def summary(path):
             continue
         if cells[2] not in rows:
             methods.append(cells[2])
-        r = rows.setdefault(cells[2], {"correct": 0, "cells": 0, "false": [], "true": [],
-                                       "flagged": [0, 0]})
+        r = rows.setdefault(cells[2], {"correct": 0, "every": 0, "cells": 0, "false": [],
+                                       "true": [], "flagged": [0, 0]})
         for key, cell in (("false", cells[5]), ("true", cells[6])):
             kept, total = (int(x) for x in cell.split(" of "))
             r[key].append(kept / total)
         r["cells"] += 2
         r["correct"] += sum(c.startswith("**") for c in cells[7:9])
         for c in cells[7:9]:
+            right, _, of = c.strip("*").split(" ")[0].replace("*", "").partition("/")
+            r["every"] += right.isdigit() and right == of
+        for c in cells[7:9]:
             if c.endswith("· flagged"):
                 r["flagged"][0 if c.startswith("**") else 1] += 1
     cells = max((r["cells"] for r in rows.values()), default=0)
-    print(f"| method | one correct model (of {cells} cells) | false pairs kept (median) "
-          "| true pairs kept (median) | `check` flags: correct / other models |")
-    print("|---|---:|---:|---:|---:|")
+    print(f"| method | one correct model (of {cells} cells) | every camera correct, any models "
+          "| false pairs kept (median) | true pairs kept (median) "
+          "| `check` flags: correct / other models |")
+    print("|---|---:|---:|---:|---:|---:|")
     for m in methods:
         r = rows[m]
-        print(f"| {m} | {r['correct']} | {100 * statistics.median(r['false']):.0f}% "
+        print(f"| {m} | {r['correct']} | {r['every']} | {100 * statistics.median(r['false']):.0f}% "
               f"| {100 * statistics.median(r['true']):.0f}% | {r['flagged'][0]} / {r['flagged'][1]} |")
 
 

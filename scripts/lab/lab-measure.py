@@ -23,8 +23,8 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             verified pairs FILE lists, one `NAME1 NAME2` a line, e.g. another method's
             selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; `repair`:
             the repair loop after the `disambiguation` run of the same variant, order and mapper:
-            `check` its model, and where it is ghosted `prune --model` it and map once more,
-            else that run stands); --order, default image_id; mapper colmap3.8
+            `check` its model, and where it is ghosted `prune --model` with every model so far
+            and map once more, at most REPAIR_TURNS times, else that run stands); --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).
 
@@ -66,6 +66,8 @@ import sys
 from colmap_files import ROOT, VGSEL, natural, only_pairs, read_images, view_graph
 
 WINDOW = 3
+# The repair loop's turns at most (`repair` runs), as scripts/lab/repair-loop.sh's default.
+REPAIR_TURNS = 3
 
 
 def log(msg):
@@ -296,18 +298,30 @@ def scored_run(images, work, dbs, spec):
         result.setdefault("database",
                           db if preset == "full" else os.path.join(work, f"pruned_{tag}.db"))
         return result
-    prune_preset, loop = preset, []
     if preset == "repair":
-        first = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}")
-        checked = subprocess.run([VGSEL, "check", "--model", first["sparse"], "--database_path",
-                                  first["database"]], capture_output=True)
-        if checked.returncode not in (0, 3):
-            sys.exit(f"lab-measure: check failed on {first['sparse']}: {checked.stderr.decode()}")
-        if checked.returncode == 0:  # clean: the loop stops at the first model
-            result = dict(first, preset="repair", loop="clean, not repaired")
-            json.dump(result, open(path, "w"), indent=1)
-            return result
-        prune_preset, loop = "disambiguation", ["--model", first["sparse"]]
+        result, models = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}"), []
+        for turn in range(1, REPAIR_TURNS + 1):
+            checked = subprocess.run([VGSEL, "check", "--model", result["sparse"],
+                                      "--database_path", result["database"]], capture_output=True)
+            if checked.returncode not in (0, 3):
+                sys.exit(f"lab-measure: check failed on {result['sparse']}: "
+                         f"{checked.stderr.decode()}")
+            if checked.returncode == 0:  # clean: the loop stops at this model
+                break
+            models += ["--model", result["sparse"]]
+            result = measured(images, work, db, variant, order, kind, extra, None,
+                              tag if turn == 1 else f"{tag}_turn{turn}", "disambiguation", models)
+        result = dict(result, preset="repair", turns=len(models) // 2)
+        json.dump(result, open(path, "w"), indent=1)
+        return result
+    result = measured(images, work, db, variant, order, kind, extra, listed, tag, preset, [])
+    json.dump(result, open(path, "w"), indent=1)
+    return result
+
+
+def measured(images, work, db, variant, order, kind, extra, listed, tag, preset, loop):
+    """One run, prune (PRESET with EXTRA and LOOP's options; `full`, `truth` or LISTED pairs
+    without), mapper and eval, its files named by TAG: its record."""
     if preset == "full":
         pruned, r = db, None
     elif preset == "truth":
@@ -319,7 +333,7 @@ def scored_run(images, work, dbs, spec):
         report = os.path.join(work, f"prune_{tag}.json")
         if not os.path.exists(report):
             run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
-                 "--preset", prune_preset, "--order", order, "--report", report, *extra, *loop])
+                 "--preset", preset, "--order", order, "--report", report, *extra, *loop])
         r = json.load(open(report))
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
@@ -332,19 +346,17 @@ def scored_run(images, work, dbs, spec):
         e.update(models=0, registered=0, correct=0, images=[])
     uncertain = set(json.load(open(os.path.join(work, "truth.json")))["uncertain"])
     agreed = [i for i in e["images"] if i["name"] not in uncertain]
-    result = {"preset": preset, "variant": variant, "order": order, "mapper": kind,
-              "prune_args": " ".join(extra), "sparse": sparse, "database": pruned,
-              "flow": r and r["flow"],
-              "pairs_total": r["pairs_total"] if r else e["pairs"]["used"],
-              "pairs_selected": r["pairs_selected"] if r else e["pairs"]["used"],
-              "within_5": r and r["order"]["selected_within_window"],
-              "models": e["models"], "registered": e["registered"], "correct": e["correct"],
-              "correct_agreed": sum(i["correct"] for i in agreed),
-              "images": e["images_ground_truth"], "false_kept": e["pairs"]["false"],
-              "false_total": e["pairs"]["baseline"]["false"], "true_kept": e["pairs"]["true"],
-              "true_total": e["pairs"]["baseline"]["true"]}
-    json.dump(result, open(path, "w"), indent=1)
-    return result
+    return {"preset": preset, "variant": variant, "order": order, "mapper": kind,
+            "prune_args": " ".join(extra), "sparse": sparse, "database": pruned,
+            "flow": r and r["flow"],
+            "pairs_total": r["pairs_total"] if r else e["pairs"]["used"],
+            "pairs_selected": r["pairs_selected"] if r else e["pairs"]["used"],
+            "within_5": r and r["order"]["selected_within_window"],
+            "models": e["models"], "registered": e["registered"], "correct": e["correct"],
+            "correct_agreed": sum(i["correct"] for i in agreed),
+            "images": e["images_ground_truth"], "false_kept": e["pairs"]["false"],
+            "false_total": e["pairs"]["baseline"]["false"], "true_kept": e["pairs"]["true"],
+            "true_total": e["pairs"]["baseline"]["true"]}
 
 
 def check_inputs(work, images, dbs, orbit):

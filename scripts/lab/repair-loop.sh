@@ -5,7 +5,8 @@
 # prunes a copy (PRUNE_ARGS, default --preset disambiguation), maps it, runs `check` on the
 # model, and where check says ghosted prunes again with --model and maps once more. Every model
 # is scored against the ground truth. Prints one row per run and mapper; writes WORKDIR/loop.json.
-# SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh).
+# SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
+# most [3], each passing every earlier model to `prune --model`.
 # usage: scripts/lab/repair-loop.sh [WORKDIR] [RUNS] [MAPPERS]
 #        (defaults: target/repair-loop, 5, "global incremental")
 set -euo pipefail
@@ -13,6 +14,7 @@ cd "$(dirname "$0")/../.."
 work=${1:-target/repair-loop}
 runs=${2:-5}
 mappers=${3:-global incremental}
+turns=${TURNS:-3}
 # shellcheck source=scripts/lab/demo-matching.sh
 source scripts/lab/demo-matching.sh
 demo_setup "$work"
@@ -41,20 +43,19 @@ for run in $(seq 1 "$runs"); do
       cp "$dir/full.db" "$db"
       # shellcheck disable=SC2086 # PRUNE_ARGS is a list of options
       "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$db"
-      map_with "$mapper" "$db" "$dir/${mapper}_1"
-      score "$dir/${mapper}_1" "$db" >"$dir/${mapper}_1.eval.json"
-      status=0
-      "$bin" check --model "$dir/${mapper}_1" --database_path "$db" \
-        --report "$dir/${mapper}_1.check.json" >"$dir/${mapper}_1.check.txt" || status=$?
-      if [ "$status" -eq 3 ]; then
+      models=()
+      for step in $(seq 1 $((turns + 1))); do
+        model=$dir/${mapper}_$step
+        map_with "$mapper" "$db" "$model"
+        score "$model" "$db" >"$model.eval.json"
+        status=0
+        "$bin" check --model "$model" --database_path "$db" \
+          --report "$model.check.json" >"$model.check.txt" || status=$?
+        [ "$status" -eq 3 ] && [ "$step" -le "$turns" ] || break
+        models+=(--model "$model")
         # shellcheck disable=SC2086
-        "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$db" \
-          --model "$dir/${mapper}_1"
-        map_with "$mapper" "$db" "$dir/${mapper}_2"
-        score "$dir/${mapper}_2" "$db" >"$dir/${mapper}_2.eval.json"
-        "$bin" check --model "$dir/${mapper}_2" --database_path "$db" \
-          --report "$dir/${mapper}_2.check.json" >"$dir/${mapper}_2.check.txt" || true
-      fi
+        "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$db" "${models[@]}"
+      done
     done
   done
 done
@@ -62,31 +63,29 @@ python3 - "$work" "$runs" "$mappers" "$num_images" <<'PY'
 import json, os, sys
 work, runs, mappers, n = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
 rows = []
-print(f"{'run':>3} {'matching':<12} {'mapper':<12} {'first: correct':>14} {'check':>8} "
-      f"{'repaired: correct':>17} {'check':>8}")
+verdict = lambda g: "ghosted" if g else "clean"
+print(f"{'run':>3} {'matching':<12} {'mapper':<10} {'first: correct':>14} {'check':>8} "
+      f"{'turns':>5} {'after the loop: correct':>23} {'models':>6} {'check':>8}")
 for run in range(1, runs + 1):
     for matcher in ["colmap3.8", "pycolmap4.2"]:
         for mapper in mappers:
             base = f"{work}/{run}/{matcher}/{mapper}"
-            row = dict(run=run, matching=matcher, mapper=mapper)
-            if not os.path.exists(f"{base}_1.eval.json"):
+            steps = []
+            while os.path.exists(f"{base}_{len(steps) + 1}.eval.json"):
+                e = json.load(open(f"{base}_{len(steps) + 1}.eval.json"))
+                c = json.load(open(f"{base}_{len(steps) + 1}.check.json"))
+                steps.append(dict(correct=e["correct"], registered=e["registered"],
+                                  models=e["models"], ghosted=c["ghosted"]))
+            if not steps:
                 continue
-            for step in (1, 2):
-                if not os.path.exists(f"{base}_{step}.eval.json"):
-                    continue
-                e = json.load(open(f"{base}_{step}.eval.json"))
-                c = json.load(open(f"{base}_{step}.check.json"))
-                row[f"correct{step}"] = e["correct"]
-                row[f"registered{step}"] = e["registered"]
-                row[f"ghosted{step}"] = c["ghosted"]
-            rows.append(row)
-            verdict = lambda g: "ghosted" if g else "clean"
-            second = (f"{row['correct2']:>14}/{n} {verdict(row['ghosted2']):>8}"
-                      if "correct2" in row else f"{'(not run)':>17} {'':>8}")
-            print(f"{run:>3} {matcher:<12} {mapper:<12} {row['correct1']:>11}/{n} "
-                  f"{verdict(row['ghosted1']):>8} {second}")
-final = [r.get("correct2", r["correct1"]) for r in rows]
+            rows.append(dict(run=run, matching=matcher, mapper=mapper, steps=steps))
+            first, last = steps[0], steps[-1]
+            after = (f"{last['correct']:>20}/{n} {last['models']:>6} {verdict(last['ghosted']):>8}"
+                     if len(steps) > 1 else f"{'(not needed)':>23} {'':>6} {'':>8}")
+            print(f"{run:>3} {matcher:<12} {mapper:<10} {first['correct']:>11}/{n} "
+                  f"{verdict(first['ghosted']):>8} {len(steps) - 1:>5} {after}")
+final = [r["steps"][-1]["correct"] for r in rows]
 print(f"after the loop: {n}/{n} correct in {sum(c == n for c in final)} of {len(final)} runs; "
-      f"before it: {sum(r['correct1'] == n for r in rows)} of {len(rows)}")
+      f"before it: {sum(r['steps'][0]['correct'] == n for r in rows)} of {len(rows)}")
 json.dump(rows, open(f"{work}/loop.json", "w"), indent=1)
 PY
