@@ -414,7 +414,13 @@ fn hall(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
         let centre = Vector3::new(x, -3.2, 1.6) + draws.jitter(0.2);
         poses.push((centre, Vector3::new(1.5 * x, 0.0, 0.8) + draws.jitter(0.4)));
     }
-    draws.orbit(&mut poses, 5.0, num_images - walk - per_orbit, 1.5 * PI, TAU);
+    draws.orbit(
+        &mut poses,
+        5.0,
+        num_images - walk - per_orbit,
+        1.5 * PI,
+        TAU,
+    );
     (cuboids, poses)
 }
 

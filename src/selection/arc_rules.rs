@@ -385,12 +385,22 @@ mod tests {
         let name = |id: u32| images[id as usize - 1].name.clone();
         let list = |path: &str, entries: Vec<Vec<String>>| NameList {
             path: PathBuf::from(path),
-            entries: entries.into_iter().enumerate().map(|(k, e)| (k + 1, e)).collect(),
+            entries: entries
+                .into_iter()
+                .enumerate()
+                .map(|(k, e)| (k + 1, e))
+                .collect(),
         };
         let overrides = Overrides {
             model_conflicts: vec![
-                list("sparse", vec![vec![name(2), name(3)], vec![name(1), name(4)]]),
-                list("sparse2", vec![vec![name(1), name(4)], vec![name(3), name(4)]]),
+                list(
+                    "sparse",
+                    vec![vec![name(2), name(3)], vec![name(1), name(4)]],
+                ),
+                list(
+                    "sparse2",
+                    vec![vec![name(1), name(4)], vec![name(3), name(4)]],
+                ),
             ],
             ..Overrides::default()
         };
