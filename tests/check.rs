@@ -147,10 +147,12 @@ fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
     let full_model = s(&work.join("sparse_full"));
     let args = ["prune", "-q", "--preset", "general", "--model", &full_model];
     let database = s(&work.join("full.db"));
+    let first_report = s(&work.join("prune_repaired.json"));
     let out = vgsel(
         &[
             &args[..],
             &["--database_path", &database, "--output", &s(&repaired)],
+            &["--report", &first_report],
         ]
         .concat(),
     );
@@ -186,6 +188,7 @@ fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
         eval["registered"],
         String::from_utf8_lossy(&check.stdout)
     );
+    second_turn_keeps_the_first_turns_blame(work, &first_report, &s(&model));
     if truth_ghosted(&full) {
         assert!(!truth_ghosted(&eval), "the repair left a ghost: {eval}");
         assert_eq!(
@@ -194,4 +197,43 @@ fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
         );
         assert_eq!(check.status.code(), Some(0), "{check:?}");
     }
+}
+
+/// A second turn of the loop (`--model` given twice: the full model and the repaired one) blames
+/// at least every pair the first turn blamed, and records both folders.
+fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repaired: &str) {
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (full_model, report) = (s(&work.join("sparse_full")), s(&work.join("turn2.json")));
+    let database = s(&work.join("full.db"));
+    let out = vgsel(&[
+        "prune",
+        "-q",
+        "--preset",
+        "general",
+        "--dry_run",
+        "--database_path",
+        &database,
+        "--model",
+        &full_model,
+        "--model",
+        repaired,
+        "--report",
+        &report,
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let read = |path: &str| -> Value {
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    };
+    let blamed = |report: &Value| -> Vec<Value> {
+        let list = &report["overrides"]["model_conflicts"];
+        list.as_array().cloned().unwrap_or_default()
+    };
+    let (first, second) = (read(first_report), read(&report));
+    for pair in blamed(&first) {
+        assert!(blamed(&second).contains(&pair), "{pair} not blamed again");
+    }
+    assert_eq!(
+        second["parameters"]["model"],
+        serde_json::json!([full_model, repaired])
+    );
 }
