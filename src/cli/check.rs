@@ -69,18 +69,22 @@ impl CheckArgs {
     }
 }
 
-/// The line a model gets: its verdict, score and groups.
-fn verdict_line(dir: &Path, c: &ModelCheck) -> String {
+/// The line a model gets: its verdict, score and groups; a clean model whose worst split had
+/// fewer judged samples than `min_conflicts` says so, as no ghost could have been found there.
+fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
     let what = if c.ghosted { "GHOSTED" } else { "clean" };
     let mut line = format!("{}: {what} (score {:.2}", dir.display(), c.score);
     if let Some(w) = &c.worst {
+        let judged = w.counts.conflicting + w.counts.agreeing;
         line += &format!(
-            ", {} conflicting of {} judged; groups of {} and {} images",
+            ", {} conflicting of {judged} judged; groups of {} and {} images",
             w.counts.conflicting,
-            w.counts.conflicting + w.counts.agreeing,
             w.groups[0].len(),
             w.groups[1].len()
         );
+        if judged < min_conflicts {
+            line += "; too few samples to find a ghost";
+        }
         if c.ghosted {
             let pairs: Vec<String> = w
                 .joining_pairs
@@ -122,7 +126,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     for (k, dir) in dirs.iter().enumerate() {
         let model = read_sparse_model(dir)?;
         let result = check::check_model(&model, evidence.as_ref(), &settings)?;
-        println!("{}", verdict_line(dir, &result));
+        println!("{}", verdict_line(dir, &result, settings.min_conflicts));
         if let (Some(plots), Some(views)) = (&args.plots, &result.views) {
             std::fs::create_dir_all(plots)
                 .with_context(|| format!("creating {}", plots.display()))?;
@@ -151,4 +155,48 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(ghosted)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use check::{conflict::Counts, Split};
+
+    fn checked(conflicting: usize, agreeing: usize) -> ModelCheck {
+        let names = |n: usize| (0..n).map(|k| format!("{k}.png")).collect();
+        ModelCheck {
+            images: 6,
+            points: 10,
+            splits_scored: 1,
+            ghosted: false,
+            score: 0.0,
+            worst: Some(Split {
+                groups: [names(3), names(3)],
+                counts: Counts {
+                    conflicting,
+                    agreeing,
+                    ..Counts::default()
+                },
+                ratio: 0.0,
+                score: 0.0,
+                joining_pairs: Vec::new(),
+            }),
+            side: Vec::new(),
+            views: None,
+        }
+    }
+
+    /// A clean verdict on fewer judged samples than a ghost needs conflicts says so; one on
+    /// enough samples does not.
+    #[test]
+    fn a_clean_verdict_on_too_few_samples_says_so() {
+        let line = verdict_line(Path::new("sparse/1"), &checked(2, 10), 30);
+        assert_eq!(
+            line,
+            "sparse/1: clean (score 0.00, 2 conflicting of 12 judged; groups of 3 and 3 \
+             images; too few samples to find a ghost)"
+        );
+        let line = verdict_line(Path::new("sparse/0"), &checked(2, 100), 30);
+        assert!(!line.contains("too few"), "{line}");
+    }
 }
