@@ -14,7 +14,6 @@ pub mod plot;
 pub mod splits;
 pub mod views;
 
-use crate::colmap::database::Database;
 use crate::colmap::sparse::SparseModel;
 use anyhow::Result;
 use conflict::{ConflictSettings, Counts};
@@ -269,21 +268,20 @@ fn describe(
 }
 
 /// The repair's evidence (`prune --model DIR`): in each model of `dir` (a model folder or a
-/// mapper's output_path) that the check finds ghosted (with `db`'s matches), the pairs of images across its worst
+/// mapper's output_path) that the check finds ghosted (with the database's `evidence`), the pairs of images across its worst
 /// split that share 3D points: the pairs whose matches glued one copy onto the other. Pairs
 /// across the split that share no point are not blamed: in a ghosted model they are mostly the
 /// true links the mapper could not use (measured on the demo scene: docs/check.md). Name pairs,
 /// sorted; empty when no model is ghosted.
 pub fn conflicting_pairs(
     dir: &std::path::Path,
-    db: &Database,
+    evidence: &Evidence,
     settings: &CheckSettings,
 ) -> Result<Vec<[String; 2]>> {
-    let evidence = Evidence::load(db)?;
     let mut blamed = std::collections::BTreeSet::new();
     for model_dir in crate::colmap::model::model_dirs(dir)? {
         let model = crate::colmap::sparse::read_sparse_model(&model_dir)?;
-        let checked = check_model(&model, Some(&evidence), settings)?;
+        let checked = check_model(&model, Some(evidence), settings)?;
         let Some(worst) = checked.worst.filter(|_| checked.ghosted) else {
             continue;
         };

@@ -192,21 +192,26 @@ impl Parameters {
                 .transpose()
         };
         let rules = &self.arc_rules;
-        let model_conflicts = rules.model.iter().map(|dir| {
-            let pairs = check::conflicting_pairs(dir, db, &check::DEFAULT_SETTINGS)
-                .with_context(|| format!("checking --model {}", dir.display()))?;
-            let entries = pairs.into_iter().enumerate();
-            let entries = entries.map(|(k, [a, b])| (k + 1, vec![a, b])).collect();
-            anyhow::Ok(NameList {
-                path: dir.to_path_buf(),
-                entries,
-            })
-        });
+        let mut model_conflicts = Vec::new();
+        if !rules.model.is_empty() {
+            // The database's side of the check, read once for every --model folder.
+            let evidence = check::evidence::Evidence::load(db)?;
+            for dir in &rules.model {
+                let pairs = check::conflicting_pairs(dir, &evidence, &check::DEFAULT_SETTINGS)
+                    .with_context(|| format!("checking --model {}", dir.display()))?;
+                let entries = pairs.into_iter().enumerate();
+                let entries = entries.map(|(k, [a, b])| (k + 1, vec![a, b])).collect();
+                model_conflicts.push(NameList {
+                    path: dir.to_path_buf(),
+                    entries,
+                });
+            }
+        }
         Ok(Overrides {
             keep_pairs: read(&rules.keep_pairs, true)?,
             forbid_pairs: read(&rules.forbid_pairs, true)?,
             forbid_images: read(&rules.forbid_images, false)?,
-            model_conflicts: model_conflicts.collect::<Result<_>>()?,
+            model_conflicts,
         })
     }
 }
