@@ -84,7 +84,7 @@ pub struct Split {
 
 /// The check of one model.
 #[derive(Clone, Debug, Serialize)]
-pub struct ModelCheck {
+pub struct ModelCheck<'e> {
     /// Registered images.
     pub images: usize,
     /// 3D points.
@@ -102,16 +102,16 @@ pub struct ModelCheck {
     pub side: Vec<bool>,
     /// The views (for plots).
     #[serde(skip)]
-    pub views: Option<Views>,
+    pub views: Option<Views<'e>>,
 }
 
 /// Checks one model, with the database's evidence if there is one (without: joining pairs are
 /// the model's cross-group links, and split tracks count as conflicts).
-pub fn check_model(
+pub fn check_model<'e>(
     model: &SparseModel,
-    evidence: Option<&Evidence>,
+    evidence: Option<&'e Evidence>,
     settings: &CheckSettings,
-) -> Result<ModelCheck> {
+) -> Result<ModelCheck<'e>> {
     let views = Views::new(model, settings.conflict.radius, evidence)?;
     let pairs = evidence.map(|e| &e.pairs);
     let n = views.views.len();

@@ -278,12 +278,8 @@ fn pairs_that_glued_the_copies_are_named_even_once_the_database_invalidated_them
     // A database whose every pair a prune has since invalidated (none usable): the pairs that
     // share points in the model still joined the groups, so a second `prune --model` blames
     // them again.
-    let check = check_model(
-        &ghosted_model(),
-        Some(&Evidence::default()),
-        &DEFAULT_SETTINGS,
-    )
-    .unwrap();
+    let evidence = Evidence::default();
+    let check = check_model(&ghosted_model(), Some(&evidence), &DEFAULT_SETTINGS).unwrap();
     assert!(check.ghosted, "score {}", check.score);
     let joining = check.worst.unwrap().joining_pairs;
     assert!(!joining.is_empty());

@@ -78,6 +78,10 @@ impl Intrinsics {
 /// iterated, so the hash order cannot reach a result.
 pub type Grid = HashMap<(i64, i64), Vec<([f64; 2], usize)>>;
 
+/// Matches between two views a < b, borrowed from the [`Evidence`], by (a, b): each pair's
+/// matches, and whether their columns are (keypoint of b, keypoint of a) rather than (a, b).
+pub type ViewMatches<'e> = HashMap<(usize, usize), (&'e [[u32; 2]], bool)>;
+
 /// One registered image, ready to project into.
 #[derive(Clone, Debug)]
 pub struct View {
@@ -98,9 +102,10 @@ pub struct View {
     pub keypoints: Vec<[f64; 2]>,
 }
 
-/// The model as the check reads it. Points and views are indexed densely, in id order.
+/// The model as the check reads it, borrowing the database's matches from the [`Evidence`].
+/// Points and views are indexed densely, in id order.
 #[derive(Clone, Debug)]
-pub struct Views {
+pub struct Views<'e> {
     /// Registered images, in image-id order.
     pub views: Vec<View>,
     /// 3D point positions.
@@ -113,16 +118,19 @@ pub struct Views {
     pub seen_by: Vec<Vec<usize>>,
     /// Grid cell size in pixels (the neighbourhood radius).
     pub cell: f64,
-    /// Verified matches between registered views a < b: (a, b) -> (keypoint of a, keypoint
-    /// of b). Empty without a database.
-    pub matches: HashMap<(usize, usize), Vec<[u32; 2]>>,
+    /// Verified matches between registered views. Empty without a database.
+    pub matches: ViewMatches<'e>,
 }
 
-impl Views {
+impl<'e> Views<'e> {
     /// Prepares `model`; `radius` is the neighbourhood radius as a fraction of each image's
     /// diagonal (the grid is built for the largest image's radius); `evidence` gives the
     /// matches.
-    pub fn new(model: &SparseModel, radius: f64, evidence: Option<&Evidence>) -> Result<Views> {
+    pub fn new(
+        model: &SparseModel,
+        radius: f64,
+        evidence: Option<&'e Evidence>,
+    ) -> Result<Views<'e>> {
         let cameras: BTreeMap<u32, &ModelCamera> =
             model.cameras.iter().map(|c| (c.camera_id, c)).collect();
         let index: BTreeMap<u64, usize> = model
@@ -207,12 +215,10 @@ impl Views {
             xy.is_some_and(|xy| (xy[0] - to[0]).hypot(xy[1] - to[1]) <= r)
         };
         let (ka, kb) = (&self.views[a].keypoints, &self.views[b].keypoints);
-        let (key, swap) = if a < b {
-            ((a, b), false)
-        } else {
-            ((b, a), true)
-        };
-        self.matches.get(&key).is_some_and(|m| {
+        let key = (a.min(b), a.max(b));
+        self.matches.get(&key).is_some_and(|&(m, flipped)| {
+            // Each match as (keypoint of a, keypoint of b).
+            let swap = flipped != (a > b);
             m.iter().any(|&m| {
                 let [x, y] = if swap { [m[1], m[0]] } else { m };
                 near(kb.get(y as usize), at, radius_b) && near(ka.get(x as usize), from, radius_a)
@@ -255,8 +261,8 @@ impl Views {
     }
 }
 
-/// The evidence's matches between registered views, by view indices a < b.
-fn view_matches(views: &[View], evidence: &Evidence) -> HashMap<(usize, usize), Vec<[u32; 2]>> {
+/// The evidence's matches between registered views.
+fn view_matches<'e>(views: &[View], evidence: &'e Evidence) -> ViewMatches<'e> {
     let index: HashMap<&str, usize> = views
         .iter()
         .enumerate()
@@ -265,12 +271,7 @@ fn view_matches(views: &[View], evidence: &Evidence) -> HashMap<(usize, usize), 
     let mut out = HashMap::new();
     for ((n1, n2), m) in &evidence.matches {
         if let (Some(&a), Some(&b)) = (index.get(n1.as_str()), index.get(n2.as_str())) {
-            let oriented = if a < b {
-                m.clone()
-            } else {
-                m.iter().map(|&[x, y]| [y, x]).collect()
-            };
-            out.insert((a.min(b), a.max(b)), oriented);
+            out.insert((a.min(b), a.max(b)), (m.as_slice(), a > b));
         }
     }
     out

@@ -162,7 +162,7 @@ mod tests {
     use super::*;
     use check::{conflict::Counts, Split};
 
-    fn checked(conflicting: usize, agreeing: usize) -> ModelCheck {
+    fn checked(conflicting: usize, agreeing: usize) -> ModelCheck<'static> {
         let names = |n: usize| (0..n).map(|k| format!("{k}.png")).collect();
         ModelCheck {
             images: 6,
