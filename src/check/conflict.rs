@@ -133,11 +133,12 @@ fn judge(
     let x = views.points[k];
     let view = &views.views[b];
     let to_b = x - view.centre;
+    let (ray_b, distance_b) = (to_b.normalize(), to_b.norm());
     let cos_max = settings.max_angle_deg.to_radians().cos();
     let close = from.iter().any(|&(a, _)| {
         let to_a = x - views.views[a].centre;
-        let scale = to_b.norm() / to_a.norm();
-        to_b.normalize().dot(&to_a.normalize()) >= cos_max
+        let scale = distance_b / to_a.norm();
+        ray_b.dot(&to_a.normalize()) >= cos_max
             && scale <= settings.max_scale
             && scale * settings.max_scale >= 1.0
     });
