@@ -269,11 +269,10 @@ def summary(path):
             kept, total = (int(x) for x in cell.split(" of "))
             r[key].append(kept / total)
         r["cells"] += 2
-        r["correct"] += sum(c.startswith("**") for c in cells[7:9])
         for c in cells[7:9]:
-            right, _, of = c.strip("*").split(" ")[0].replace("*", "").partition("/")
+            r["correct"] += c.startswith("**")
+            right, _, of = c.split(" ")[0].replace("*", "").partition("/")
             r["every"] += right.isdigit() and right == of
-        for c in cells[7:9]:
             if c.endswith("· flagged"):
                 r["flagged"][0 if c.startswith("**") else 1] += 1
     cells = max((r["cells"] for r in rows.values()), default=0)
