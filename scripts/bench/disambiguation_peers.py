@@ -22,7 +22,8 @@ usage:
       the database each model was mapped from.
   disambiguation_peers.py summary TABLE.md         (any python 3)
       per method, from a table the `table` command printed: the cells with one correct model,
-      and the median (over the table's rows) of the false and the true pairs kept.
+      those with every camera correct in any number of models, the median (over the table's
+      rows) of the false and the true pairs kept, and the models `check` flagged.
 
 Settings: the checkout's README and its notebooks for the small yan2017 scenes. Yan: track
 degree 3, coverage 0.9, alpha 0.1, at least 5 shared unique tracks, pairs kept at a score >= 0.3
