@@ -6,39 +6,13 @@
 //! neither hide how good the rest is nor tilt the fit away from it.
 
 use crate::colmap::model::ModelImage;
+pub use crate::geometry::similarity::Similarity;
 use anyhow::{bail, ensure, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rand::seq::index::sample;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
-
-/// x -> scale * rotation * x + translation.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Similarity {
-    /// Scale factor (true units per model unit).
-    pub scale: f64,
-    /// Rotation applied after scaling.
-    pub rotation: Rotation3<f64>,
-    /// Translation applied last.
-    pub translation: Vector3<f64>,
-}
-
-impl Similarity {
-    /// The similarity that changes nothing (a model already in the ground truth's frame).
-    pub fn identity() -> Similarity {
-        Similarity {
-            scale: 1.0,
-            rotation: Rotation3::identity(),
-            translation: Vector3::zeros(),
-        }
-    }
-
-    /// Maps a point of the model frame into the ground truth's frame.
-    pub fn apply(&self, x: &Vector3<f64>) -> Vector3<f64> {
-        self.scale * (self.rotation * x) + self.translation
-    }
-}
 
 /// One camera pose in a frame: world-to-camera rotation and centre.
 #[derive(Clone, Copy, Debug)]

@@ -4,4 +4,5 @@
 pub mod camera;
 pub mod focal;
 pub mod pose;
+pub mod similarity;
 pub mod view_geometry;
