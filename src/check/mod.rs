@@ -10,6 +10,7 @@
 
 pub mod conflict;
 pub mod evidence;
+pub mod join;
 pub mod plot;
 pub mod splits;
 pub mod views;
@@ -152,7 +153,7 @@ pub fn check_model<'e>(
 }
 
 /// A split's score: conflicting over judged samples plus the prior.
-fn score(c: &Counts, settings: &CheckSettings) -> f64 {
+pub(crate) fn score(c: &Counts, settings: &CheckSettings) -> f64 {
     c.conflicting as f64 / (c.conflicting + c.agreeing + settings.prior).max(1) as f64
 }
 
@@ -267,21 +268,35 @@ fn describe(
     }
 }
 
-/// The repair's evidence (`prune --model DIR`): in each model of `dir` (a model folder or a
-/// mapper's output_path) that the check finds ghosted (with the database's `evidence`), the pairs of images across its worst
-/// split that share 3D points: the pairs whose matches glued one copy onto the other. Pairs
-/// across the split that share no point are not blamed: in a ghosted model they are mostly the
-/// true links the mapper could not use (measured on the demo scene: docs/check.md). Name pairs,
-/// sorted; empty when no model is ghosted.
-pub fn conflicting_pairs(
+/// What a mapper's output says about the database's pairs (`prune --model DIR`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ModelEvidence {
+    /// In each model the check finds ghosted, the pairs across its worst split that share 3D
+    /// points: the pairs whose matches glued one copy onto the other. Pairs across the split that
+    /// share no point are not blamed: in a ghosted model they are mostly the true links the
+    /// mapper could not use (measured on the demo scene: docs/check.md). Sorted.
+    pub blamed: Vec<[String; 2]>,
+    /// The pairs that link clean models the database's matches place in one frame without a
+    /// conflict ([`join`]): what the mapper needs to make one model of them. Sorted.
+    pub links: Vec<[String; 2]>,
+}
+
+/// The repair's evidence from the models of `dir` (a model folder or a mapper's output_path),
+/// checked with the database's `evidence`.
+pub fn model_evidence(
     dir: &std::path::Path,
     evidence: &Evidence,
     settings: &CheckSettings,
-) -> Result<Vec<[String; 2]>> {
+) -> Result<ModelEvidence> {
     let mut blamed = std::collections::BTreeSet::new();
-    for model_dir in crate::colmap::model::model_dirs(dir)? {
-        let model = crate::colmap::sparse::read_sparse_model(&model_dir)?;
-        let checked = check_model(&model, Some(evidence), settings)?;
+    let models = crate::colmap::model::model_dirs(dir)?
+        .iter()
+        .map(|d| crate::colmap::sparse::read_sparse_model(d))
+        .collect::<Result<Vec<_>>>()?;
+    let mut verdicts = Vec::new();
+    for model in &models {
+        let checked = check_model(model, Some(evidence), settings)?;
+        verdicts.push(checked.ghosted);
         let Some(worst) = checked.worst.filter(|_| checked.ghosted) else {
             continue;
         };
@@ -289,7 +304,18 @@ pub fn conflicting_pairs(
             blamed.insert([p.image1.clone(), p.image2.clone()]);
         }
     }
-    Ok(blamed.into_iter().collect())
+    let checked: Vec<_> = models.iter().zip(verdicts).collect();
+    let mut links = std::collections::BTreeSet::new();
+    for join in join::join_models(&checked, evidence, settings)? {
+        for l in join.links {
+            let (a, b) = (l.image1, l.image2);
+            links.insert(if a < b { [a, b] } else { [b, a] });
+        }
+    }
+    Ok(ModelEvidence {
+        blamed: blamed.into_iter().collect(),
+        links: links.into_iter().collect(),
+    })
 }
 
 #[cfg(test)]

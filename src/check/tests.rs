@@ -5,7 +5,9 @@
 use super::*;
 use crate::colmap::model::{ModelCamera, ModelImage};
 use crate::colmap::sparse::{Point2D, SparseImage};
+use crate::geometry::similarity::Similarity;
 use nalgebra::{UnitQuaternion, Vector3};
+use std::collections::BTreeSet;
 
 /// A deterministic generator in [0, 1).
 struct Lcg(u64);
@@ -286,4 +288,125 @@ fn pairs_that_glued_the_copies_are_named_even_once_the_database_invalidated_them
     assert!(joining
         .iter()
         .all(|p| p.shared_points > 0 && p.inliers == 0));
+}
+
+/// `model`'s images that `in_b` picks, with their points under new ids (`+ offset`), carried
+/// into another frame by `placement`; and the rest, as they were.
+fn two_models(
+    model: &SparseModel,
+    in_b: impl Fn(&SparseImage) -> bool,
+    offset: u64,
+    placement: &Similarity,
+) -> (SparseModel, SparseModel) {
+    let pick = |b: bool| {
+        let images: Vec<SparseImage> = model
+            .images
+            .iter()
+            .filter(|im| in_b(im) == b)
+            .cloned()
+            .map(|mut im| {
+                if b {
+                    im.points2d
+                        .iter_mut()
+                        .for_each(|p| p.point3d_id = p.point3d_id.map(|id| id + offset));
+                }
+                im
+            })
+            .collect();
+        let ids: BTreeSet<u64> = images
+            .iter()
+            .flat_map(|im| im.points2d.iter().filter_map(|p| p.point3d_id))
+            .collect();
+        let shift = if b { offset } else { 0 };
+        let points = model
+            .points
+            .iter()
+            .map(|(id, p)| (id + shift, *p))
+            .filter(|(id, _)| ids.contains(id))
+            .collect();
+        SparseModel {
+            cameras: model.cameras.clone(),
+            images,
+            points,
+        }
+    };
+    let b = join::put_together(&SparseModel::default(), &pick(true), placement).0;
+    (pick(false), b)
+}
+
+/// Matches between every image of `a` and of `b` that see the same point of the scene (ids
+/// equal modulo `offset`).
+fn matches_between(a: &SparseModel, b: &SparseModel, offset: u64) -> Evidence {
+    let keypoint_of = |im: &SparseImage| -> BTreeMap<u64, u32> {
+        im.points2d
+            .iter()
+            .enumerate()
+            .filter_map(|(k, p)| Some((p.point3d_id? % offset, k as u32)))
+            .collect()
+    };
+    let mut evidence = Evidence::default();
+    for ia in &a.images {
+        for ib in &b.images {
+            let (ka, kb) = (keypoint_of(ia), keypoint_of(ib));
+            let m: Vec<[u32; 2]> = ka
+                .iter()
+                .filter_map(|(id, &x)| kb.get(id).map(|&y| [x, y]))
+                .collect();
+            let (na, nb) = (ia.image.name.clone(), ib.image.name.clone());
+            let (key, m) = if na < nb {
+                ((na, nb), m)
+            } else {
+                ((nb, na), m.into_iter().map(|[x, y]| [y, x]).collect())
+            };
+            evidence.matches.insert(key, m);
+        }
+    }
+    evidence
+}
+
+/// Some similarity far from the identity.
+fn elsewhere() -> Similarity {
+    Similarity {
+        scale: 0.3,
+        rotation: nalgebra::Rotation3::from_euler_angles(0.4, 2.0, -0.7),
+        translation: Vector3::new(10.0, -3.0, 7.0),
+    }
+}
+
+/// The correct wall's twelve cameras as two models, each in its own frame: the database's
+/// matches place the second where it belongs, and every pair with matches links them.
+#[test]
+fn two_models_of_one_wall_are_joined_where_they_belong() {
+    let (a, b) = two_models(&correct_model(), |im| im.image.image_id > 6, 100_000, &elsewhere());
+    let evidence = matches_between(&a, &b, 100_000);
+    let joins = join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS)
+        .unwrap();
+    assert_eq!(joins.len(), 1);
+    let join = &joins[0];
+    assert_eq!(join.models, [0, 1]);
+    assert_eq!(join.rejected, 0);
+    assert_eq!(join.support, join.correspondences);
+    assert!(join.counts.conflicting + join.counts.agreeing > 0, "{:?}", join.counts);
+    let pairs_with_matches = evidence.matches.values().filter(|m| m.len() >= 5).count();
+    assert_eq!(join.links.len(), pairs_with_matches);
+    // A ghosted model is not joined to anything.
+    let none = join::join_models(&[(&a, true), (&b, false)], &evidence, &DEFAULT_SETTINGS);
+    assert!(none.unwrap().is_empty());
+}
+
+/// The ghosted model's two walls as two models: their matches (on the shared object) place
+/// one wall's cameras onto the other's, which conflicts, so they are not joined.
+#[test]
+fn two_copies_matched_on_their_repeated_object_are_not_joined() {
+    let ghost = ghosted_model();
+    let (a, b) = two_models(&ghost, |im| im.image.image_id % 2 == 0, 100_000, &elsewhere());
+    let evidence = matches_between(&a, &b, 100_000);
+    let joins = join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS)
+        .unwrap();
+    assert!(joins.is_empty(), "{joins:?}");
+    // What refused them is the conflict: a check that never calls a ghost joins them.
+    let mut blind = DEFAULT_SETTINGS;
+    blind.threshold = 1.0;
+    let joins = join::join_models(&[(&a, false), (&b, false)], &evidence, &blind).unwrap();
+    assert_eq!(joins.len(), 1);
 }

@@ -102,6 +102,28 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
     line + ")"
 }
 
+/// The line a join gets: the two models, how many pairs link them and how well they agree.
+fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
+    let judged = j.counts.conflicting + j.counts.agreeing;
+    format!(
+        "{} + {}: one scene (placed by {} of {} correspondences, score {:.2}, {} conflicting of \
+         {judged} judged); {} pairs link them, e.g. {}",
+        dirs[j.models[0]].display(),
+        dirs[j.models[1]].display(),
+        j.support,
+        j.correspondences,
+        j.score,
+        j.counts.conflicting,
+        j.links.len(),
+        j.links
+            .iter()
+            .take(3)
+            .map(|l| format!("{}-{}", l.image1, l.image2))
+            .collect::<Vec<_>>()
+            .join(" ")
+    )
+}
+
 /// Runs the check; Ok(true) when some model is ghosted. `quiet` silences the note on stderr.
 pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     let settings = args.settings();
@@ -121,11 +143,14 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         "no COLMAP model in {}",
         args.model.display()
     );
+    let models = dirs
+        .iter()
+        .map(|dir| read_sparse_model(dir))
+        .collect::<Result<Vec<_>>>()?;
     let mut reports = Vec::new();
-    let mut ghosted = false;
-    for (k, dir) in dirs.iter().enumerate() {
-        let model = read_sparse_model(dir)?;
-        let result = check::check_model(&model, evidence.as_ref(), &settings)?;
+    let mut verdicts = Vec::new();
+    for (k, (dir, model)) in dirs.iter().zip(&models).enumerate() {
+        let result = check::check_model(model, evidence.as_ref(), &settings)?;
         println!("{}", verdict_line(dir, &result, settings.min_conflicts));
         if let (Some(plots), Some(views)) = (&args.plots, &result.views) {
             std::fs::create_dir_all(plots)
@@ -143,14 +168,36 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
                 &plots.join(format!("top_view_{k}.svg")),
             )?;
         }
-        ghosted |= result.ghosted;
+        verdicts.push(result.ghosted);
         let mut value = serde_json::to_value(&result)?;
         value["model"] = dir.display().to_string().into();
         reports.push(value);
     }
+    let ghosted = verdicts.iter().any(|g| *g);
+    // Clean models of one run that the database's matches place in one frame without a
+    // conflict: `prune --model` keeps the pairs that link them.
+    let joins = match &evidence {
+        Some(e) => {
+            let checked: Vec<_> = models.iter().zip(verdicts.iter().copied()).collect();
+            check::join::join_models(&checked, e, &settings)?
+        }
+        None => Vec::new(),
+    };
+    let mut joined = Vec::new();
+    for join in &joins {
+        println!("{}", join_line(&dirs, join));
+        let mut value = serde_json::to_value(join)?;
+        value["model_paths"] = join
+            .models
+            .iter()
+            .map(|&m| dirs[m].display().to_string())
+            .collect::<Vec<_>>()
+            .into();
+        joined.push(value);
+    }
     if let Some(path) = &args.report {
         let report =
-            serde_json::json!({ "ghosted": ghosted, "settings": settings, "models": reports });
+            serde_json::json!({ "ghosted": ghosted, "settings": settings, "models": reports, "joins": joined });
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
     }

@@ -259,6 +259,12 @@ impl Report {
                 blamed.len()
             );
         }
+        if let Some(links) = o.model_links.as_ref().filter(|l| !l.is_empty()) {
+            s += &format!(
+                "\nmodel check: {} pairs that link clean models into one kept",
+                links.len()
+            );
+        }
         if self.order.keep_neighbours > 0 {
             s += &format!(
                 "\nclose neighbours: {} pairs within {} positions kept",

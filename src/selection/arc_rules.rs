@@ -1,10 +1,11 @@
 //! The arc rules: which pair arcs of the paper's network are fixed (kept whatever the flow
 //! selects) or removed before the flow runs, besides the costs. Four sources, applied in this
-//! order: the user's overrides (`--keep_pairs`, `--forbid_pairs`, `--forbid_images`), the
-//! pairs a model check blames (`--model`: the pairs that glued a ghosted model's copies, see
-//! [`crate::check::conflicting_pairs`]), close neighbours in a capture sequence
-//! (`--keep_neighbours`), and the fitness floor (`--min_pair_fitness`, lowered as far as the
-//! search needs).
+//! order: the model check's evidence (`--model`: the pairs that glued a ghosted model's copies
+//! are removed, and the pairs that link clean models placed in one frame are kept, whatever an
+//! earlier model blamed; see [`crate::check::model_evidence`]), the user's overrides
+//! (`--forbid_images`, `--forbid_pairs`, which win over the models', then `--keep_pairs`),
+//! close neighbours in a capture sequence (`--keep_neighbours`), and the fitness floor
+//! (`--min_pair_fitness`, lowered as far as the search needs).
 //!
 //! Rules change the network ([`crate::flow::network::SelectionProblem::restrict`]), never
 //! the costs, so the result stays an exact min-cost flow and is easy to explain:
@@ -42,7 +43,8 @@ pub struct ArcRules {
     /// `--forbid_images`: the file of images never selected.
     pub forbid_images: Option<PathBuf>,
     /// `--model`: mappers' outputs on this database; the pairs that glued a model the check
-    /// finds ghosted, in any of them, are never selected.
+    /// finds ghosted, in any of them, are never selected, and the pairs that link clean models
+    /// are kept.
     pub model: Vec<PathBuf>,
 }
 
@@ -101,6 +103,8 @@ pub struct Overrides {
     /// `--model`: the pairs the model check blames, never selected (a pair list per folder,
     /// whose path is the folder).
     pub model_conflicts: Vec<NameList>,
+    /// `--model`: the pairs that link clean models, kept (a pair list per folder).
+    pub model_links: Vec<NameList>,
 }
 
 /// The overrides as listed in the report, by image name.
@@ -119,6 +123,10 @@ pub struct Listed {
     /// Pairs the model check blamed (`--model`), never selected; absent without `--model`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model_conflicts: Option<Vec<[String; 2]>>,
+    /// Pairs that link clean models (`--model`), kept unless the user forbade them; absent
+    /// without `--model`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_links: Option<Vec<[String; 2]>>,
 }
 
 /// Overrides resolved against a view graph.
@@ -148,14 +156,15 @@ impl Overrides {
             forbidden_vertices: vec![false; graph.num_vertices()],
             listed: Listed::default(),
         };
+        if !self.model_conflicts.is_empty() {
+            resolved.forbid_model_conflicts(&self.model_conflicts, &names)?;
+            resolved.keep_model_links(&self.model_links, &names)?;
+        }
         if let Some(list) = &self.forbid_images {
             resolved.forbid_images(list, &names, graph)?;
         }
         if let Some(list) = &self.forbid_pairs {
             resolved.forbid_pairs(list, &names)?;
-        }
-        if !self.model_conflicts.is_empty() {
-            resolved.forbid_model_conflicts(&self.model_conflicts, &names)?;
         }
         if let Some(list) = &self.keep_pairs {
             resolved.keep_pairs(list, &names, min_num_matches)?;
@@ -269,6 +278,26 @@ impl Resolved {
             }
         }
         self.listed.model_conflicts = Some(blamed);
+        Ok(())
+    }
+
+    /// `--model`: the pairs that link clean models are fixed (those that are edges), even where
+    /// an earlier model blamed them: a ghost's blame falls on every pair across its split, true
+    /// links included, and a placement without conflict tells them apart. Listed once each.
+    fn keep_model_links(&mut self, lists: &[NameList], names: &Names) -> Result<()> {
+        let (mut linked, mut seen) = (Vec::new(), std::collections::BTreeSet::new());
+        for list in lists {
+            for (line, entry) in &list.entries {
+                if let Some(k) = names.edge(list, *line, entry)? {
+                    self.edges[k] = ArcRule::Fixed;
+                }
+                let pair = [entry[0].clone(), entry[1].clone()];
+                if seen.insert(pair.clone()) {
+                    linked.push(pair);
+                }
+            }
+        }
+        self.listed.model_links = Some(linked);
         Ok(())
     }
 
@@ -420,6 +449,41 @@ mod tests {
             .listed
             .model_conflicts
             .is_none());
+    }
+
+    /// A pair that links clean models is kept even where another folder blamed it, and is
+    /// listed; the user's `--forbid_pairs` wins over it.
+    #[test]
+    fn pairs_that_link_clean_models_are_kept_unless_the_user_forbids_them() {
+        let images = images(4);
+        let pairs: Vec<VerifiedPair> = (1..4).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let name = |id: u32| images[id as usize - 1].name.clone();
+        let list = |path: &str, entries: Vec<Vec<String>>| NameList {
+            path: PathBuf::from(path),
+            entries: entries
+                .into_iter()
+                .enumerate()
+                .map(|(k, e)| (k + 1, e))
+                .collect(),
+        };
+        let mut overrides = Overrides {
+            model_conflicts: vec![
+                list("sparse", vec![vec![name(2), name(3)], vec![name(3), name(4)]]),
+                list("sparse2", vec![]),
+            ],
+            model_links: vec![list("sparse", vec![]), list("sparse2", vec![vec![name(3), name(2)]])],
+            ..Overrides::default()
+        };
+        let resolved = overrides.resolve(&images, &graph, 15).unwrap();
+        assert_eq!(
+            resolved.edges,
+            [ArcRule::Free, ArcRule::Fixed, ArcRule::Removed]
+        );
+        assert_eq!(resolved.listed.model_links.unwrap(), [[name(3), name(2)]]);
+        overrides.forbid_pairs = Some(list("forbid.txt", vec![vec![name(2), name(3)]]));
+        let resolved = overrides.resolve(&images, &graph, 15).unwrap();
+        assert_eq!(resolved.edges[1], ArcRule::Removed);
     }
 
     #[test]

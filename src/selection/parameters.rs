@@ -183,8 +183,8 @@ impl Parameters {
         Parameters::resolve(given).expect("a preset's own parameters resolve")
     }
 
-    /// The override files named in `arc_rules`, read, and the pairs the model check blames in
-    /// `--model`'s models (with `db`'s matches).
+    /// The override files named in `arc_rules`, read, and the pairs the model check blames and
+    /// the pairs that link clean models in `--model`'s folders (with `db`'s matches).
     pub fn read_overrides(&self, db: &Database) -> Result<Overrides> {
         let read = |path: &Option<PathBuf>, pairs| {
             path.as_deref()
@@ -192,19 +192,23 @@ impl Parameters {
                 .transpose()
         };
         let rules = &self.arc_rules;
-        let mut model_conflicts = Vec::new();
+        let (mut model_conflicts, mut model_links) = (Vec::new(), Vec::new());
         if !rules.model.is_empty() {
             // The database's side of the check, read once for every --model folder.
             let evidence = check::evidence::Evidence::load(db)?;
             for dir in &rules.model {
-                let pairs = check::conflicting_pairs(dir, &evidence, &check::DEFAULT_SETTINGS)
+                let found = check::model_evidence(dir, &evidence, &check::DEFAULT_SETTINGS)
                     .with_context(|| format!("checking --model {}", dir.display()))?;
-                let entries = pairs.into_iter().enumerate();
-                let entries = entries.map(|(k, [a, b])| (k + 1, vec![a, b])).collect();
-                model_conflicts.push(NameList {
+                let list = |pairs: Vec<[String; 2]>| NameList {
                     path: dir.to_path_buf(),
-                    entries,
-                });
+                    entries: pairs
+                        .into_iter()
+                        .enumerate()
+                        .map(|(k, [a, b])| (k + 1, vec![a, b]))
+                        .collect(),
+                };
+                model_conflicts.push(list(found.blamed));
+                model_links.push(list(found.links));
             }
         }
         Ok(Overrides {
@@ -212,6 +216,7 @@ impl Parameters {
             forbid_pairs: read(&rules.forbid_pairs, true)?,
             forbid_images: read(&rules.forbid_images, false)?,
             model_conflicts,
+            model_links,
         })
     }
 }

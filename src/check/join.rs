@@ -1,0 +1,316 @@
+//! Where two models of one mapper run sit relative to each other. A mapper that cannot cross
+//! from one part of a scene to another leaves several models; after a repair has forbidden the
+//! pairs that glued two copies together, one model per copy is common (the hall design:
+//! docs/check.md). The database still holds matches between the models, true ones and the
+//! copies' false ones, and each proposes a placement of one model in the other's frame.
+//!
+//! The placements are found from 3D-3D correspondences (two matched keypoints, each on a point
+//! of its own model): the similarity most of them agree on, then the one most of the rest agree
+//! on (sequential RANSAC, [`PLACEMENTS`] at most). Each is tested as a ghost is: the two models
+//! put together must not conflict ([`super::conflict`]) and must overlap enough to say so.
+//! False matches between copies propose the placement that folds one copy onto the other, and
+//! that placement conflicts; the first placement that does not joins the models, and the
+//! database pairs whose correspondences agree with it are the links a mapper needs to make one
+//! model of the two (`prune --model` keeps them).
+
+use super::conflict::{self, Counts};
+use super::evidence::Evidence;
+use super::views::Views;
+use super::CheckSettings;
+use crate::colmap::model::ModelImage;
+use crate::colmap::sparse::{SparseImage, SparseModel};
+use crate::geometry::similarity::Similarity;
+use nalgebra::{UnitQuaternion, Vector3};
+use rand::seq::index::sample;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Placements tried per pair of models, most supported first.
+pub const PLACEMENTS: usize = 3;
+/// Random minimal samples (three correspondences) drawn per placement.
+pub const HYPOTHESES: usize = 2000;
+/// A correspondence agrees with a placement within this distance, as a fraction of the first
+/// model's spread (the median distance of its points to their centroid).
+pub const INLIER_DISTANCE: f64 = 0.01;
+/// Agreeing correspondences a placement needs at least, counted over the pairs that link the
+/// models ([`PAIR_MIN_AGREEING`], [`PAIR_MIN_FRACTION`]): the positive evidence for it. Two
+/// models that meet only where the images look at each other's structure from far off or at a
+/// steep angle give the conflict test no sample (the hall's two orbits), so the test can refute
+/// a placement but not confirm one.
+pub const MIN_SUPPORT: usize = 30;
+/// A database pair links the joined models when at least this many of its correspondences...
+pub const PAIR_MIN_AGREEING: usize = 5;
+/// ... and at least this fraction of them agree with the placement (a pair between copies can
+/// have a few matches that fit by chance; measured on the hall design: docs/check.md).
+pub const PAIR_MIN_FRACTION: f64 = 0.25;
+
+/// A database pair that links two joined models.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Link {
+    /// Image of the first model.
+    pub image1: String,
+    /// Image of the second model.
+    pub image2: String,
+    /// Its correspondences (matches between points of the two models).
+    pub correspondences: usize,
+    /// Of those, the ones that agree with the placement.
+    pub agreeing: usize,
+}
+
+/// Two models joined by a placement that does not conflict.
+#[derive(Clone, Debug, Serialize)]
+pub struct Join {
+    /// The two models, as indices of the checked folders.
+    pub models: [usize; 2],
+    /// Correspondences between the two models.
+    pub correspondences: usize,
+    /// Correspondences that agree with the placement.
+    pub support: usize,
+    /// Placements tried before this one (each conflicted, or too few pairs agreed with it).
+    pub rejected: usize,
+    /// The conflicts of the two models put together, one group each.
+    pub counts: Counts,
+    /// Their score, as a split's ([`super::score`]).
+    pub score: f64,
+    /// The pairs that link the models, most agreeing correspondences first.
+    pub links: Vec<Link>,
+}
+
+/// One correspondence: the second model's point, the first's, and the database pair it is from.
+type Correspondence = (Vector3<f64>, Vector3<f64>, usize);
+
+/// The joins among `models` (each with its check's verdict: ghosted models are not joined).
+/// Each pair of clean models with at least `min_group` images each is tried.
+pub fn join_models(
+    models: &[(&SparseModel, bool)],
+    evidence: &Evidence,
+    settings: &CheckSettings,
+) -> anyhow::Result<Vec<Join>> {
+    let mut joins = Vec::new();
+    let usable = |m: &(&SparseModel, bool)| !m.1 && m.0.images.len() >= settings.min_group;
+    for a in 0..models.len() {
+        for b in a + 1..models.len() {
+            if usable(&models[a]) && usable(&models[b]) {
+                if let Some(mut join) = join_two(models[a].0, models[b].0, evidence, settings)? {
+                    join.models = [a, b];
+                    joins.push(join);
+                }
+            }
+        }
+    }
+    Ok(joins)
+}
+
+/// The first placement of `b` in `a`'s frame that does not conflict, if any.
+fn join_two(
+    a: &SparseModel,
+    b: &SparseModel,
+    evidence: &Evidence,
+    settings: &CheckSettings,
+) -> anyhow::Result<Option<Join>> {
+    let (pairs, correspondences) = correspondences(a, b, evidence);
+    let spread = spread(a);
+    let tolerance = INLIER_DISTANCE * spread;
+    let mut remaining: Vec<usize> = (0..correspondences.len()).collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    for rejected in 0..PLACEMENTS {
+        let Some((placement, inliers)) = ransac(&correspondences, &remaining, tolerance, &mut rng)
+        else {
+            break;
+        };
+        if inliers.len() < MIN_SUPPORT {
+            break;
+        }
+        let links = links(&pairs, &correspondences, &inliers);
+        let linked: usize = links.iter().map(|l| l.agreeing).sum();
+        if linked >= MIN_SUPPORT {
+            let (merged, side) = put_together(a, b, &placement);
+            let views = Views::new(&merged, settings.conflict.radius, Some(evidence))?;
+            let side: Vec<bool> = views.views.iter().map(|v| side.contains(&v.name)).collect();
+            let counts = conflict::count(&views, &side, &settings.conflict);
+            let score = super::score(&counts, settings);
+            // The check's own verdict on the two models put together.
+            if score < settings.threshold || counts.conflicting < settings.min_conflicts {
+                return Ok(Some(Join {
+                    models: [0, 0],
+                    correspondences: correspondences.len(),
+                    support: inliers.len(),
+                    rejected,
+                    counts,
+                    score,
+                    links,
+                }));
+            }
+        }
+        let used: BTreeSet<usize> = inliers.into_iter().collect();
+        remaining.retain(|k| !used.contains(k));
+    }
+    Ok(None)
+}
+
+/// The database pairs between the two models' images (image of `a`, image of `b`) and every
+/// match between keypoints that lie on a point of each model.
+fn correspondences(
+    a: &SparseModel,
+    b: &SparseModel,
+    evidence: &Evidence,
+) -> (Vec<[String; 2]>, Vec<Correspondence>) {
+    let in_a: BTreeSet<&str> = a.images.iter().map(|im| im.image.name.as_str()).collect();
+    let (mut pairs, mut out) = (Vec::new(), Vec::new());
+    for ia in &a.images {
+        for ib in b.images.iter().filter(|im| !in_a.contains(im.image.name.as_str())) {
+            let (na, nb) = (&ia.image.name, &ib.image.name);
+            let (key, swapped) = if na < nb {
+                ((na.clone(), nb.clone()), false)
+            } else {
+                ((nb.clone(), na.clone()), true)
+            };
+            let Some(matches) = evidence.matches.get(&key) else {
+                continue;
+            };
+            let pair = pairs.len();
+            pairs.push([na.clone(), nb.clone()]);
+            for m in matches {
+                let (ka, kb) = if swapped { (m[1], m[0]) } else { (m[0], m[1]) };
+                if let (Some(xa), Some(xb)) = (point_of(a, ia, ka), point_of(b, ib, kb)) {
+                    out.push((xb, xa, pair));
+                }
+            }
+        }
+    }
+    (pairs, out)
+}
+
+/// The model point keypoint `k` of `image` lies on, if any.
+fn point_of(model: &SparseModel, image: &SparseImage, k: u32) -> Option<Vector3<f64>> {
+    let id = image.points2d.get(k as usize)?.point3d_id?;
+    model.points.get(&id).map(|p| Vector3::new(p[0], p[1], p[2]))
+}
+
+/// The median distance of the model's points to their centroid.
+fn spread(model: &SparseModel) -> f64 {
+    let points: Vec<Vector3<f64>> = model
+        .points
+        .values()
+        .map(|p| Vector3::new(p[0], p[1], p[2]))
+        .collect();
+    if points.is_empty() {
+        return 0.0;
+    }
+    let centroid = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
+    let mut d: Vec<f64> = points.iter().map(|p| (p - centroid).norm()).collect();
+    let mid = d.len() / 2;
+    *d.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// The similarity (second model's frame -> first's) most of the `remaining` correspondences
+/// agree with within `tolerance`, refitted on them, with those that agree after the refit.
+fn ransac(
+    c: &[Correspondence],
+    remaining: &[usize],
+    tolerance: f64,
+    rng: &mut ChaCha8Rng,
+) -> Option<(Similarity, Vec<usize>)> {
+    if remaining.len() < 3 {
+        return None;
+    }
+    let agreeing = |s: &Similarity| -> Vec<usize> {
+        remaining
+            .iter()
+            .copied()
+            .filter(|&k| (s.apply(&c[k].0) - c[k].1).norm() < tolerance)
+            .collect()
+    };
+    let fit = |set: &[usize]| {
+        let from: Vec<_> = set.iter().map(|&k| c[k].0).collect();
+        let to: Vec<_> = set.iter().map(|&k| c[k].1).collect();
+        Similarity::fit(&from, &to)
+    };
+    let mut best: Option<(Similarity, Vec<usize>)> = None;
+    for _ in 0..HYPOTHESES {
+        let idx = sample(rng, remaining.len(), 3);
+        let set: Vec<usize> = idx.iter().map(|i| remaining[i]).collect();
+        let Some(s) = fit(&set) else { continue };
+        let inliers = agreeing(&s);
+        if best.as_ref().is_none_or(|b| inliers.len() > b.1.len()) {
+            best = Some((s, inliers));
+        }
+    }
+    let (s, inliers) = best?;
+    // One least-squares refit on the agreeing correspondences, kept if it loses none.
+    match fit(&inliers).map(|r| (agreeing(&r), r)) {
+        Some((refit, r)) if refit.len() >= inliers.len() => Some((r, refit)),
+        _ => Some((s, inliers)),
+    }
+}
+
+/// Model `a` with `b`'s images (those `a` lacks) and points carried into `a`'s frame by
+/// `placement`, point ids after `a`'s; and the names of the images from `b`.
+pub(crate) fn put_together(
+    a: &SparseModel,
+    b: &SparseModel,
+    placement: &Similarity,
+) -> (SparseModel, BTreeSet<String>) {
+    let mut merged = a.clone();
+    let offset = a.points.keys().next_back().map_or(0, |id| id + 1);
+    for camera in &b.cameras {
+        if !merged.cameras.iter().any(|c| c.camera_id == camera.camera_id) {
+            merged.cameras.push(camera.clone());
+        }
+    }
+    let names: BTreeSet<String> = a.images.iter().map(|im| im.image.name.clone()).collect();
+    let mut from_b = BTreeSet::new();
+    let inverse = placement.rotation.inverse();
+    for im in b.images.iter().filter(|im| !names.contains(&im.image.name)) {
+        // x_cam = R_c x + t_c with x = R^T (x' - T) / s; scaled by s (a pose's scale does not
+        // change what it sees): R_c' = R_c R^T, t_c' = s t_c - R_c' T.
+        let rotation_matrix = im.image.rotation.to_rotation_matrix() * inverse;
+        let translation = placement.scale * im.image.translation
+            - (rotation_matrix * placement.translation);
+        let mut moved = im.clone();
+        moved.image = ModelImage {
+            rotation: UnitQuaternion::from_rotation_matrix(&rotation_matrix),
+            translation,
+            ..im.image.clone()
+        };
+        for p in &mut moved.points2d {
+            p.point3d_id = p.point3d_id.map(|id| id + offset);
+        }
+        from_b.insert(im.image.name.clone());
+        merged.images.push(moved);
+    }
+    for (id, p) in &b.points {
+        let x = placement.apply(&Vector3::new(p[0], p[1], p[2]));
+        merged.points.insert(id + offset, [x[0], x[1], x[2]]);
+    }
+    (merged, from_b)
+}
+
+/// The pairs with at least [`PAIR_MIN_AGREEING`] agreeing correspondences that are at least
+/// [`PAIR_MIN_FRACTION`] of theirs, most agreeing first.
+fn links(pairs: &[[String; 2]], c: &[Correspondence], inliers: &[usize]) -> Vec<Link> {
+    let mut total: BTreeMap<usize, usize> = BTreeMap::new();
+    c.iter().for_each(|x| *total.entry(x.2).or_default() += 1);
+    let mut agreeing: BTreeMap<usize, usize> = BTreeMap::new();
+    inliers
+        .iter()
+        .for_each(|&k| *agreeing.entry(c[k].2).or_default() += 1);
+    let mut out: Vec<Link> = agreeing
+        .into_iter()
+        .filter(|&(p, n)| n >= PAIR_MIN_AGREEING && n as f64 >= PAIR_MIN_FRACTION * total[&p] as f64)
+        .map(|(p, n)| Link {
+            image1: pairs[p][0].clone(),
+            image2: pairs[p][1].clone(),
+            correspondences: total[&p],
+            agreeing: n,
+        })
+        .collect();
+    out.sort_by(|x, y| {
+        y.agreeing
+            .cmp(&x.agreeing)
+            .then((&x.image1, &x.image2).cmp(&(&y.image1, &y.image2)))
+    });
+    out
+}
