@@ -17,8 +17,9 @@
 #   SINGLE_CAMERA   one camera for all images [1]
 #   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
 #   REPAIR          N > 0: the repair loop (docs/check.md), at most N turns: `vgsel-colmap
-#                   check` on the last model, and where it says ghosted, `prune --model` with
-#                   every model so far and one more mapper run, a row `repairedK` per turn [0]
+#                   check` on the last model, and where it says ghosted or joins its clean
+#                   models, `prune --model` with every model so far and one more mapper run,
+#                   a row `repairedK` per turn [0]
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -88,14 +89,19 @@ map_and_eval full
 map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds
 last=pruned models=()
-for turn in $(seq 1 "${REPAIR:-0}"); do
+# Every model is checked, the last turn's too; a turn runs where the model is ghosted, or where
+# its clean models can be joined (`check` prints "A + B: one scene (...)").
+for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
+  [ "${REPAIR:-0}" -gt 0 ] || break
   status=0
   "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" \
-    --report "$work/check_$last.json" >&2 || status=$?
-  [ "$status" = 0 ] && break
-  [ "$status" = 3 ] || exit "$status"
+    --report "$work/check_$last.json" >"$work/check_$last.txt" || status=$?
+  cat "$work/check_$last.txt" >&2
+  [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
+  [ "$status" = 3 ] || grep -q ': one scene (' "$work/check_$last.txt" || break
+  [ "$turn" -le "$REPAIR" ] || break
   models+=(--model "$work/sparse_$last")
-  log "the $last model is ghosted: prune --model (turn $turn), mapper again"
+  log "the $last model is ghosted or in pieces: prune --model (turn $turn), mapper again"
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
     --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args

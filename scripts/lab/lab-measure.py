@@ -306,7 +306,8 @@ def scored_run(images, work, dbs, spec):
             if checked.returncode not in (0, 3):
                 sys.exit(f"lab-measure: check failed on {result['sparse']}: "
                          f"{checked.stderr.decode()}")
-            if checked.returncode == 0:  # clean: the loop stops at this model
+            # Clean, and no clean models to join: the loop stops at this model.
+            if checked.returncode == 0 and b": one scene (" not in checked.stdout:
                 break
             models += ["--model", result["sparse"]]
             result = measured(images, work, db, variant, order, kind, extra, None,

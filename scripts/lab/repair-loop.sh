@@ -3,8 +3,9 @@
 # COLMAP 3.8's (colmap3.8), over several fresh matchings:
 # each run matches the rendered images (COLMAP 3.8 and pycolmap 4.2, as colmap4-mappers.sh),
 # prunes a copy (PRUNE_ARGS, default --preset disambiguation), maps it, runs `check` on the
-# model, and where check says ghosted prunes again with --model and maps once more. Every model
-# is scored against the ground truth. Prints one row per run and mapper; writes WORKDIR/loop.json.
+# model, and where check says ghosted (or joins the run's clean models: "A + B: one scene")
+# prunes again with --model and maps once more. Every model is scored against the ground truth.
+# Prints one row per run and mapper; writes WORKDIR/loop.json.
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
 # most [3], each passing every earlier model to `prune --model`.
 # usage: scripts/lab/repair-loop.sh [WORKDIR] [RUNS] [MAPPERS]
@@ -51,7 +52,9 @@ for run in $(seq 1 "$runs"); do
         status=0
         "$bin" check --model "$model" --database_path "$db" \
           --report "$model.check.json" >"$model.check.txt" || status=$?
-        [ "$status" -eq 3 ] && [ "$step" -le "$turns" ] || break
+        # Another turn where the model is ghosted, or its clean models can be joined.
+        { [ "$status" -eq 3 ] || grep -q ': one scene (' "$model.check.txt"; } &&
+          [ "$step" -le "$turns" ] || break
         models+=(--model "$model")
         # shellcheck disable=SC2086
         "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$db" "${models[@]}"

@@ -160,7 +160,11 @@ fn correspondences(
     let in_a: BTreeSet<&str> = a.images.iter().map(|im| im.image.name.as_str()).collect();
     let (mut pairs, mut out) = (Vec::new(), Vec::new());
     for ia in &a.images {
-        for ib in b.images.iter().filter(|im| !in_a.contains(im.image.name.as_str())) {
+        for ib in b
+            .images
+            .iter()
+            .filter(|im| !in_a.contains(im.image.name.as_str()))
+        {
             let (na, nb) = (&ia.image.name, &ib.image.name);
             let (key, swapped) = if na < nb {
                 ((na.clone(), nb.clone()), false)
@@ -186,7 +190,10 @@ fn correspondences(
 /// The model point keypoint `k` of `image` lies on, if any.
 fn point_of(model: &SparseModel, image: &SparseImage, k: u32) -> Option<Vector3<f64>> {
     let id = image.points2d.get(k as usize)?.point3d_id?;
-    model.points.get(&id).map(|p| Vector3::new(p[0], p[1], p[2]))
+    model
+        .points
+        .get(&id)
+        .map(|p| Vector3::new(p[0], p[1], p[2]))
 }
 
 /// The median distance of the model's points to their centroid.
@@ -256,7 +263,11 @@ pub(crate) fn put_together(
     let mut merged = a.clone();
     let offset = a.points.keys().next_back().map_or(0, |id| id + 1);
     for camera in &b.cameras {
-        if !merged.cameras.iter().any(|c| c.camera_id == camera.camera_id) {
+        if !merged
+            .cameras
+            .iter()
+            .any(|c| c.camera_id == camera.camera_id)
+        {
             merged.cameras.push(camera.clone());
         }
     }
@@ -267,8 +278,8 @@ pub(crate) fn put_together(
         // x_cam = R_c x + t_c with x = R^T (x' - T) / s; scaled by s (a pose's scale does not
         // change what it sees): R_c' = R_c R^T, t_c' = s t_c - R_c' T.
         let rotation_matrix = im.image.rotation.to_rotation_matrix() * inverse;
-        let translation = placement.scale * im.image.translation
-            - (rotation_matrix * placement.translation);
+        let translation =
+            placement.scale * im.image.translation - (rotation_matrix * placement.translation);
         let mut moved = im.clone();
         moved.image = ModelImage {
             rotation: UnitQuaternion::from_rotation_matrix(&rotation_matrix),
@@ -299,7 +310,9 @@ fn links(pairs: &[[String; 2]], c: &[Correspondence], inliers: &[usize]) -> Vec<
         .for_each(|&k| *agreeing.entry(c[k].2).or_default() += 1);
     let mut out: Vec<Link> = agreeing
         .into_iter()
-        .filter(|&(p, n)| n >= PAIR_MIN_AGREEING && n as f64 >= PAIR_MIN_FRACTION * total[&p] as f64)
+        .filter(|&(p, n)| {
+            n >= PAIR_MIN_AGREEING && n as f64 >= PAIR_MIN_FRACTION * total[&p] as f64
+        })
         .map(|(p, n)| Link {
             image1: pairs[p][0].clone(),
             image2: pairs[p][1].clone(),

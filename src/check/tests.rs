@@ -377,16 +377,25 @@ fn elsewhere() -> Similarity {
 /// matches place the second where it belongs, and every pair with matches links them.
 #[test]
 fn two_models_of_one_wall_are_joined_where_they_belong() {
-    let (a, b) = two_models(&correct_model(), |im| im.image.image_id > 6, 100_000, &elsewhere());
+    let (a, b) = two_models(
+        &correct_model(),
+        |im| im.image.image_id > 6,
+        100_000,
+        &elsewhere(),
+    );
     let evidence = matches_between(&a, &b, 100_000);
-    let joins = join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS)
-        .unwrap();
+    let joins =
+        join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap();
     assert_eq!(joins.len(), 1);
     let join = &joins[0];
     assert_eq!(join.models, [0, 1]);
     assert_eq!(join.rejected, 0);
     assert_eq!(join.support, join.correspondences);
-    assert!(join.counts.conflicting + join.counts.agreeing > 0, "{:?}", join.counts);
+    assert!(
+        join.counts.conflicting + join.counts.agreeing > 0,
+        "{:?}",
+        join.counts
+    );
     let pairs_with_matches = evidence.matches.values().filter(|m| m.len() >= 5).count();
     assert_eq!(join.links.len(), pairs_with_matches);
     // A ghosted model is not joined to anything.
@@ -399,10 +408,15 @@ fn two_models_of_one_wall_are_joined_where_they_belong() {
 #[test]
 fn two_copies_matched_on_their_repeated_object_are_not_joined() {
     let ghost = ghosted_model();
-    let (a, b) = two_models(&ghost, |im| im.image.image_id % 2 == 0, 100_000, &elsewhere());
+    let (a, b) = two_models(
+        &ghost,
+        |im| im.image.image_id % 2 == 0,
+        100_000,
+        &elsewhere(),
+    );
     let evidence = matches_between(&a, &b, 100_000);
-    let joins = join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS)
-        .unwrap();
+    let joins =
+        join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap();
     assert!(joins.is_empty(), "{joins:?}");
     // What refused them is the conflict: a check that never calls a ghost joins them.
     let mut blind = DEFAULT_SETTINGS;

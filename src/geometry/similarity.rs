@@ -99,7 +99,8 @@ mod tests {
         assert!((fit.scale - known.scale).abs() < 1e-9, "{fit:?}");
         assert!((fit.rotation.matrix() - known.rotation.matrix()).norm() < 1e-9);
         assert!((fit.translation - known.translation).norm() < 1e-9);
-        let mirrored: Vec<Vector3<f64>> = to.iter().map(|x| Vector3::new(-x[0], x[1], x[2])).collect();
+        let mirrored: Vec<Vector3<f64>> =
+            to.iter().map(|x| Vector3::new(-x[0], x[1], x[2])).collect();
         let fit = Similarity::fit(&from, &mirrored).unwrap();
         assert!((fit.rotation.matrix().determinant() - 1.0).abs() < 1e-9);
     }

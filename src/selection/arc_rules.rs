@@ -469,10 +469,16 @@ mod tests {
         };
         let mut overrides = Overrides {
             model_conflicts: vec![
-                list("sparse", vec![vec![name(2), name(3)], vec![name(3), name(4)]]),
+                list(
+                    "sparse",
+                    vec![vec![name(2), name(3)], vec![name(3), name(4)]],
+                ),
                 list("sparse2", vec![]),
             ],
-            model_links: vec![list("sparse", vec![]), list("sparse2", vec![vec![name(3), name(2)]])],
+            model_links: vec![
+                list("sparse", vec![]),
+                list("sparse2", vec![vec![name(3), name(2)]]),
+            ],
             ..Overrides::default()
         };
         let resolved = overrides.resolve(&images, &graph, 15).unwrap();
