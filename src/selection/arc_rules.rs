@@ -27,7 +27,7 @@ use crate::scene::view_graph::ViewGraph;
 use crate::selection::capture_order::CaptureOrder;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The arc rules a prune was asked for (part of [`crate::selection::parameters::Parameters`]).
@@ -156,9 +156,8 @@ impl Overrides {
             forbidden_vertices: vec![false; graph.num_vertices()],
             listed: Listed::default(),
         };
-        if !self.model_conflicts.is_empty() {
-            resolved.forbid_model_conflicts(&self.model_conflicts, &names)?;
-            resolved.keep_model_links(&self.model_links, &names)?;
+        if !(self.model_conflicts.is_empty() && self.model_links.is_empty()) {
+            resolved.apply_model_evidence(&self.model_conflicts, &self.model_links, &names)?;
         }
         if let Some(list) = &self.forbid_images {
             resolved.forbid_images(list, &names, graph)?;
@@ -262,41 +261,42 @@ impl Resolved {
         Ok(())
     }
 
-    /// `--model`: the pairs the model check blames in any folder leave the network (those that
-    /// are edges); listed once each, in the order first blamed.
-    fn forbid_model_conflicts(&mut self, lists: &[NameList], names: &Names) -> Result<()> {
-        let (mut blamed, mut seen) = (Vec::new(), std::collections::BTreeSet::new());
-        for list in lists {
-            for (line, entry) in &list.entries {
-                if let Some(k) = names.edge(list, *line, entry)? {
-                    self.edges[k] = ArcRule::Removed;
-                }
-                let pair = [entry[0].clone(), entry[1].clone()];
-                if seen.insert(pair.clone()) {
-                    blamed.push(pair);
+    /// `--model`, folder by folder in the order given: the pairs a folder's ghosted models
+    /// blame leave the network and the pairs that link its clean models are fixed (those that
+    /// are edges), over what earlier folders said. A ghost's blame falls on every pair across
+    /// its split, true links included, and a later placement without conflict tells them
+    /// apart; a later ghost blames links that glued it again. Each pair listed once.
+    fn apply_model_evidence(
+        &mut self,
+        conflicts: &[NameList],
+        links: &[NameList],
+        names: &Names,
+    ) -> Result<()> {
+        let mut listed = [(Vec::new(), BTreeSet::new()), (Vec::new(), BTreeSet::new())];
+        let none = NameList {
+            path: PathBuf::new(),
+            entries: Vec::new(),
+        };
+        for k in 0..conflicts.len().max(links.len()) {
+            let (blamed, linked) = (
+                conflicts.get(k).unwrap_or(&none),
+                links.get(k).unwrap_or(&none),
+            );
+            for (list, rule, slot) in [(blamed, ArcRule::Removed, 0), (linked, ArcRule::Fixed, 1)] {
+                let (out, seen) = &mut listed[slot];
+                for (line, entry) in &list.entries {
+                    if let Some(k) = names.edge(list, *line, entry)? {
+                        self.edges[k] = rule;
+                    }
+                    let pair = [entry[0].clone(), entry[1].clone()];
+                    if seen.insert(pair.clone()) {
+                        out.push(pair);
+                    }
                 }
             }
         }
+        let [(blamed, _), (linked, _)] = listed;
         self.listed.model_conflicts = Some(blamed);
-        Ok(())
-    }
-
-    /// `--model`: the pairs that link clean models are fixed (those that are edges), even where
-    /// an earlier model blamed them: a ghost's blame falls on every pair across its split, true
-    /// links included, and a placement without conflict tells them apart. Listed once each.
-    fn keep_model_links(&mut self, lists: &[NameList], names: &Names) -> Result<()> {
-        let (mut linked, mut seen) = (Vec::new(), std::collections::BTreeSet::new());
-        for list in lists {
-            for (line, entry) in &list.entries {
-                if let Some(k) = names.edge(list, *line, entry)? {
-                    self.edges[k] = ArcRule::Fixed;
-                }
-                let pair = [entry[0].clone(), entry[1].clone()];
-                if seen.insert(pair.clone()) {
-                    linked.push(pair);
-                }
-            }
-        }
         self.listed.model_links = Some(linked);
         Ok(())
     }
@@ -451,8 +451,8 @@ mod tests {
             .is_none());
     }
 
-    /// A pair that links clean models is kept even where another folder blamed it, and is
-    /// listed; the user's `--forbid_pairs` wins over it.
+    /// A pair that links clean models is kept even where an earlier folder blamed it, and is
+    /// listed; a later folder's blame, and the user's `--forbid_pairs`, win over it.
     #[test]
     fn pairs_that_link_clean_models_are_kept_unless_the_user_forbids_them() {
         let images = images(4);
@@ -487,6 +487,14 @@ mod tests {
             [ArcRule::Free, ArcRule::Fixed, ArcRule::Removed]
         );
         assert_eq!(resolved.listed.model_links.unwrap(), [[name(3), name(2)]]);
+        // A later folder's blame wins over an earlier folder's link.
+        let mut later = overrides.clone();
+        later
+            .model_conflicts
+            .push(list("sparse3", vec![vec![name(2), name(3)]]));
+        later.model_links.push(list("sparse3", vec![]));
+        let resolved = later.resolve(&images, &graph, 15).unwrap();
+        assert_eq!(resolved.edges[1], ArcRule::Removed);
         overrides.forbid_pairs = Some(list("forbid.txt", vec![vec![name(2), name(3)]]));
         let resolved = overrides.resolve(&images, &graph, 15).unwrap();
         assert_eq!(resolved.edges[1], ArcRule::Removed);
