@@ -21,8 +21,8 @@
 
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
+use super::settings::{score, CheckSettings};
 use super::views::Views;
-use super::CheckSettings;
 use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
 use crate::geometry::similarity::Similarity;
@@ -81,7 +81,7 @@ pub struct Join {
     pub refuted: usize,
     /// The conflicts of the two models put together, one group each.
     pub counts: Counts,
-    /// Their score, as a split's ([`super::score`]).
+    /// Their score, as a split's ([`super::settings::score`]).
     pub score: f64,
     /// The pairs that link the models, most agreeing correspondences first.
     pub links: Vec<Link>,
@@ -162,7 +162,7 @@ fn join_two(
             let views = Views::new(&merged, settings.conflict.radius, Some(evidence))?;
             let side: Vec<bool> = views.views.iter().map(|v| side.contains(&v.name)).collect();
             let counts = conflict::count(&views, &side, &settings.conflict);
-            let score = super::score(&counts, settings);
+            let score = score(&counts, settings);
             // The check's own verdict on the two models put together.
             if score >= settings.threshold && counts.conflicting >= settings.min_conflicts {
                 refuted += 1;

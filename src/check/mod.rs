@@ -12,47 +12,19 @@ pub mod conflict;
 pub mod evidence;
 pub mod join;
 pub mod plot;
+pub mod settings;
 pub mod splits;
 pub mod views;
 
 use crate::colmap::sparse::SparseModel;
 use anyhow::Result;
-use conflict::{ConflictSettings, Counts};
+use conflict::Counts;
 use evidence::Evidence;
 use serde::Serialize;
+use settings::score;
+pub use settings::{CheckSettings, DEFAULT_SETTINGS};
 use std::collections::BTreeMap;
 use views::Views;
-
-/// Everything the check's verdict depends on.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct CheckSettings {
-    /// How conflicts are counted.
-    pub conflict: ConflictSettings,
-    /// Images each group of a split needs at least.
-    pub min_group: usize,
-    /// Conflict ratio from which a split is two copies.
-    pub threshold: f64,
-    /// Conflicting samples a split needs at least to be called two copies (few samples say
-    /// little).
-    pub min_conflicts: usize,
-    /// Agreeing samples every split is credited with before counting: the score is
-    /// conflicting / (judged + prior), so a ratio over few samples counts for less.
-    pub prior: usize,
-}
-
-/// The defaults, the one setting of docs/check.md's measurements.
-pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
-    conflict: ConflictSettings {
-        max_angle_deg: 30.0,
-        max_scale: 1.25,
-        radius: 0.02,
-        min_neighbours: 1,
-    },
-    min_group: 3,
-    threshold: 0.48,
-    min_conflicts: 30,
-    prior: 500,
-};
 
 /// A database pair (verified, not invalidated by a prune) between the two groups.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -150,11 +122,6 @@ pub fn check_model<'e>(
         side,
         views: Some(views),
     })
-}
-
-/// A split's score: conflicting over judged samples plus the prior.
-pub(crate) fn score(c: &Counts, settings: &CheckSettings) -> f64 {
-    c.conflicting as f64 / (c.conflicting + c.agreeing + settings.prior).max(1) as f64
 }
 
 /// A link between two images agrees when at least this many samples were judged...

@@ -1,0 +1,40 @@
+//! What the check's verdict depends on: its settings, their defaults, and a split's score.
+
+use super::conflict::{ConflictSettings, Counts};
+use serde::Serialize;
+
+/// Everything the check's verdict depends on.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct CheckSettings {
+    /// How conflicts are counted.
+    pub conflict: ConflictSettings,
+    /// Images each group of a split needs at least.
+    pub min_group: usize,
+    /// Conflict ratio from which a split is two copies.
+    pub threshold: f64,
+    /// Conflicting samples a split needs at least to be called two copies (few samples say
+    /// little).
+    pub min_conflicts: usize,
+    /// Agreeing samples every split is credited with before counting: the score is
+    /// conflicting / (judged + prior), so a ratio over few samples counts for less.
+    pub prior: usize,
+}
+
+/// The defaults, the one setting of docs/check.md's measurements.
+pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
+    conflict: ConflictSettings {
+        max_angle_deg: 30.0,
+        max_scale: 1.25,
+        radius: 0.02,
+        min_neighbours: 1,
+    },
+    min_group: 3,
+    threshold: 0.48,
+    min_conflicts: 30,
+    prior: 500,
+};
+
+/// A split's score: conflicting over judged samples plus the prior.
+pub fn score(c: &Counts, settings: &CheckSettings) -> f64 {
+    c.conflicting as f64 / (c.conflicting + c.agreeing + settings.prior).max(1) as f64
+}
