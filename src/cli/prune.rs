@@ -60,9 +60,9 @@ pub struct PruneArgs {
     #[arg(long, value_name = "FILE", help_heading = SELECT)]
     forbid_images: Option<PathBuf>,
     /// A mapper's output on this database (a model folder or its output_path), for the repair
-    /// loop: the pairs that glued a model `check` finds ghosted are never selected
-    /// (docs/check.md). Repeat it with every earlier turn's output, so that no turn selects again
-    /// what an earlier one blamed.
+    /// loop: the pairs that glued a model `check` finds ghosted are never selected, and the
+    /// pairs that link clean models `check` joins are kept (docs/check.md). Repeat it with every
+    /// earlier turn's output, in order, so that no turn selects again what an earlier one blamed.
     #[arg(long, value_name = "DIR", help_heading = SELECT)]
     model: Vec<PathBuf>,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
