@@ -378,15 +378,7 @@ fn elsewhere() -> Similarity {
 /// it either, so it could be a ghost the check cannot see, and the models are not joined.
 #[test]
 fn two_models_are_not_joined_without_a_refuted_ghost() {
-    let (a, b) = two_models(
-        &correct_model(),
-        |im| im.image.image_id > 6,
-        100_000,
-        &elsewhere(),
-    );
-    let evidence = matches_between(&a, &b, 100_000);
-    let joins =
-        join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap();
+    let joins = joins_of_a_split(&correct_model(), |im| im.image.image_id > 6);
     assert!(joins.is_empty(), "{joins:?}");
 }
 
@@ -394,17 +386,16 @@ fn two_models_are_not_joined_without_a_refuted_ghost() {
 /// one wall's cameras onto the other's, which conflicts, and nothing else places them.
 #[test]
 fn two_copies_matched_on_their_repeated_object_are_not_joined() {
-    let ghost = ghosted_model();
-    let (a, b) = two_models(
-        &ghost,
-        |im| im.image.image_id % 2 == 0,
-        100_000,
-        &elsewhere(),
-    );
-    let evidence = matches_between(&a, &b, 100_000);
-    let joins =
-        join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap();
+    let joins = joins_of_a_split(&ghosted_model(), |im| im.image.image_id % 2 == 0);
     assert!(joins.is_empty(), "{joins:?}");
+}
+
+/// The joins of `model` split into two models by `in_b`, the second in another frame, with the
+/// database matching every point the two see.
+fn joins_of_a_split(model: &SparseModel, in_b: impl Fn(&SparseImage) -> bool) -> Vec<join::Join> {
+    let (a, b) = two_models(model, in_b, 100_000, &elsewhere());
+    let evidence = matches_between(&a, &b, 100_000);
+    join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap()
 }
 
 /// Like the hall design: two identical objects in front of one wall, six cameras walking past

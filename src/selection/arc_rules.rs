@@ -403,23 +403,33 @@ mod tests {
     use crate::flow::search::Criteria;
     use crate::scene::testing::{images, pair};
 
-    /// The model check's pairs leave the network like forbidden pairs, and are listed once
-    /// each whichever folders blamed them; a blamed pair that is no view-graph edge is listed and
-    /// changes nothing.
-    #[test]
-    fn pairs_the_model_check_blames_are_never_selected() {
+    /// Four images whose neighbours are verified pairs (edges 1-2, 2-3, 3-4).
+    fn four_in_a_row() -> (Vec<Image>, ViewGraph) {
         let images = images(4);
         let pairs: Vec<VerifiedPair> = (1..4).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
         let graph = ViewGraph::build(&images, &pairs, 15);
-        let name = |id: u32| images[id as usize - 1].name.clone();
-        let list = |path: &str, entries: Vec<Vec<String>>| NameList {
+        (images, graph)
+    }
+
+    /// A pair list read from `path`, one entry a line.
+    fn list(path: &str, entries: Vec<Vec<String>>) -> NameList {
+        NameList {
             path: PathBuf::from(path),
             entries: entries
                 .into_iter()
                 .enumerate()
                 .map(|(k, e)| (k + 1, e))
                 .collect(),
-        };
+        }
+    }
+
+    /// The model check's pairs leave the network like forbidden pairs, and are listed once
+    /// each whichever folders blamed them; a blamed pair that is no view-graph edge is listed and
+    /// changes nothing.
+    #[test]
+    fn pairs_the_model_check_blames_are_never_selected() {
+        let (images, graph) = four_in_a_row();
+        let name = |id: u32| images[id as usize - 1].name.clone();
         let overrides = Overrides {
             model_conflicts: vec![
                 list(
@@ -455,18 +465,8 @@ mod tests {
     /// listed; a later folder's blame, and the user's `--forbid_pairs`, win over it.
     #[test]
     fn pairs_that_link_clean_models_are_kept_unless_the_user_forbids_them() {
-        let images = images(4);
-        let pairs: Vec<VerifiedPair> = (1..4).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
-        let graph = ViewGraph::build(&images, &pairs, 15);
+        let (images, graph) = four_in_a_row();
         let name = |id: u32| images[id as usize - 1].name.clone();
-        let list = |path: &str, entries: Vec<Vec<String>>| NameList {
-            path: PathBuf::from(path),
-            entries: entries
-                .into_iter()
-                .enumerate()
-                .map(|(k, e)| (k + 1, e))
-                .collect(),
-        };
         let mut overrides = Overrides {
             model_conflicts: vec![
                 list(
