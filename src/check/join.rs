@@ -27,9 +27,6 @@ use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
 use crate::geometry::similarity::Similarity;
 use nalgebra::{UnitQuaternion, Vector3};
-use rand::seq::index::sample;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -145,7 +142,7 @@ fn join_two(
     let spread = spread(a);
     let tolerance = INLIER_DISTANCE * spread;
     let mut remaining: Vec<usize> = (0..correspondences.len()).collect();
-    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let mut rng = SplitMix(0);
     let mut refuted = 0;
     for _ in 0..PLACEMENTS {
         let Some((placement, inliers)) = ransac(&correspondences, &remaining, tolerance, &mut rng)
@@ -234,6 +231,32 @@ fn point_of(model: &SparseModel, image: &SparseImage, k: u32) -> Option<Vector3<
         .map(|p| Vector3::new(p[0], p[1], p[2]))
 }
 
+/// A seeded generator (splitmix64) for RANSAC's samples: the check stays deterministic, and the
+/// tool without the evaluation tooling needs no random-number crate (scripts/ci/test.sh).
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Three distinct entries of `from` (at least three long).
+    fn three_of(&mut self, from: &[usize]) -> Vec<usize> {
+        let mut picked: Vec<usize> = Vec::with_capacity(3);
+        while picked.len() < 3 {
+            let k = (self.next() % from.len() as u64) as usize;
+            if !picked.contains(&k) {
+                picked.push(k);
+            }
+        }
+        picked.into_iter().map(|k| from[k]).collect()
+    }
+}
+
 /// The median distance of the model's points to their centroid.
 fn spread(model: &SparseModel) -> f64 {
     let points: Vec<Vector3<f64>> = model
@@ -256,7 +279,7 @@ fn ransac(
     c: &[Correspondence],
     remaining: &[usize],
     tolerance: f64,
-    rng: &mut ChaCha8Rng,
+    rng: &mut SplitMix,
 ) -> Option<(Similarity, Vec<usize>)> {
     if remaining.len() < 3 {
         return None;
@@ -275,8 +298,7 @@ fn ransac(
     };
     let mut best: Option<(Similarity, Vec<usize>)> = None;
     for _ in 0..HYPOTHESES {
-        let idx = sample(rng, remaining.len(), 3);
-        let set: Vec<usize> = idx.iter().map(|i| remaining[i]).collect();
+        let set = rng.three_of(remaining);
         let Some(s) = fit(&set) else { continue };
         let inliers = agreeing(&s);
         if best.as_ref().is_none_or(|b| inliers.len() > b.1.len()) {
