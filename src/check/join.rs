@@ -121,20 +121,19 @@ pub fn join_models(
     for a in 0..models.len() {
         for b in a + 1..models.len() {
             if usable(&models[a]) && usable(&models[b]) {
-                if let Some(mut join) = join_two(models[a].0, models[b].0, evidence, settings)? {
-                    join.models = [a, b];
-                    joins.push(join);
-                }
+                let pair = [models[a].0, models[b].0];
+                joins.extend(join_two([a, b], pair, evidence, settings)?);
             }
         }
     }
     Ok(joins)
 }
 
-/// The first placement of `b` in `a`'s frame that does not conflict, if any.
+/// The join of models `[a, b]` (their indices `models`): the first placement of `b` in `a`'s
+/// frame that does not conflict, if a stronger one did.
 fn join_two(
-    a: &SparseModel,
-    b: &SparseModel,
+    models: [usize; 2],
+    [a, b]: [&SparseModel; 2],
     evidence: &Evidence,
     settings: &CheckSettings,
 ) -> anyhow::Result<Option<Join>> {
@@ -168,7 +167,7 @@ fn join_two(
                 // conflicted: without that, it may be a ghost the check cannot see (copies that
                 // share their surroundings), and nothing tells it from a true one.
                 return Ok((refuted > 0).then(|| Join {
-                    models: [0, 0],
+                    models,
                     correspondences: correspondences.len(),
                     placement: Placement::from(&placement),
                     support: inliers.len(),
