@@ -4,7 +4,7 @@
 //! truth's.
 
 use serde_json::Value;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use vgsel_colmap::eval::render::{Scene, SceneKind};
 
@@ -83,11 +83,15 @@ fn truth_ghosted(eval: &Value) -> bool {
     wrong >= 2 && wrong * 5 >= registered
 }
 
-#[test]
-fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
+/// The rendered scene `kind` (`num_images`, seed 1) in a temporary folder, run through
+/// `scripts/pipeline.sh` with `--preset disambiguation` and `REPAIR=repair` turns of the loop
+/// (1024 SIFT features, the renderer's intrinsics): the folder and the pipeline's work folder.
+fn pipeline(kind: SceneKind, num_images: usize, repair: u32) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
-    let scene = Scene::build(SceneKind::Duplicate, 20, 1).unwrap();
-    scene.write(dir.path()).unwrap();
+    Scene::build(kind, num_images, 1)
+        .unwrap()
+        .write(dir.path())
+        .unwrap();
     let work = dir.path().join("work");
     let out = Command::new("bash")
         .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/pipeline.sh"))
@@ -100,9 +104,16 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
         .env("MAX_FEATURES", "1024")
         .env("PRUNE_ARGS", "--preset disambiguation")
         .env("CAMERA_PARAMS", "400,240,180,0")
+        .env("REPAIR", repair.to_string())
         .output()
         .expect("running scripts/pipeline.sh");
     assert!(out.status.success(), "pipeline failed: {out:?}");
+    (dir, work)
+}
+
+#[test]
+fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
+    let (dir, work) = pipeline(SceneKind::Duplicate, 20, 0);
     let mut verdicts = Vec::new();
     for variant in ["full", "pruned"] {
         let eval: Value = serde_json::from_str(
@@ -245,25 +256,7 @@ fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repa
 /// them: one model, every camera correct. About two minutes on 2 cores.
 #[test]
 fn the_repair_loop_makes_one_correct_model_of_the_halls_two_orbits() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = Scene::build(SceneKind::Hall, 38, 1).unwrap();
-    scene.write(dir.path()).unwrap();
-    let work = dir.path().join("work");
-    let out = Command::new("bash")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/pipeline.sh"))
-        .args([
-            dir.path().join("images"),
-            work.clone(),
-            dir.path().join("gt"),
-        ])
-        .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
-        .env("MAX_FEATURES", "1024")
-        .env("PRUNE_ARGS", "--preset disambiguation")
-        .env("CAMERA_PARAMS", "400,240,180,0")
-        .env("REPAIR", "3")
-        .output()
-        .expect("running scripts/pipeline.sh");
-    assert!(out.status.success(), "pipeline failed: {out:?}");
+    let (_dir, work) = pipeline(SceneKind::Hall, 38, 3);
     let read = |name: &str| -> Option<Value> {
         let text = std::fs::read_to_string(work.join(name)).ok()?;
         Some(serde_json::from_str(&text).unwrap())
