@@ -100,11 +100,17 @@ pub struct Overrides {
     pub forbid_pairs: Option<NameList>,
     /// `--forbid_images`: images taken out of the network with all their pairs.
     pub forbid_images: Option<NameList>,
-    /// `--model`: the pairs the model check blames, never selected (a pair list per folder,
-    /// whose path is the folder).
-    pub model_conflicts: Vec<NameList>,
-    /// `--model`: the pairs that link clean models, kept (a pair list per folder).
-    pub model_links: Vec<NameList>,
+    /// `--model`: what the model check says of each folder, in the order given.
+    pub model: Vec<ModelFolder>,
+}
+
+/// What the model check says of one `--model` folder: two pair lists whose path is the folder.
+#[derive(Clone, Debug)]
+pub struct ModelFolder {
+    /// The pairs that glued its ghosted models: never selected.
+    pub blamed: NameList,
+    /// The pairs that link its clean models: kept.
+    pub links: NameList,
 }
 
 /// The overrides as listed in the report, by image name.
@@ -156,8 +162,8 @@ impl Overrides {
             forbidden_vertices: vec![false; graph.num_vertices()],
             listed: Listed::default(),
         };
-        if !(self.model_conflicts.is_empty() && self.model_links.is_empty()) {
-            resolved.apply_model_evidence(&self.model_conflicts, &self.model_links, &names)?;
+        if !self.model.is_empty() {
+            resolved.apply_model_evidence(&self.model, &names)?;
         }
         if let Some(list) = &self.forbid_images {
             resolved.forbid_images(list, &names, graph)?;
@@ -266,23 +272,13 @@ impl Resolved {
     /// are edges), over what earlier folders said. A ghost's blame falls on every pair across
     /// its split, true links included, and a later placement without conflict tells them
     /// apart; a later ghost blames links that glued it again. Each pair listed once.
-    fn apply_model_evidence(
-        &mut self,
-        conflicts: &[NameList],
-        links: &[NameList],
-        names: &Names,
-    ) -> Result<()> {
+    fn apply_model_evidence(&mut self, folders: &[ModelFolder], names: &Names) -> Result<()> {
         let mut listed = [(Vec::new(), BTreeSet::new()), (Vec::new(), BTreeSet::new())];
-        let none = NameList {
-            path: PathBuf::new(),
-            entries: Vec::new(),
-        };
-        for k in 0..conflicts.len().max(links.len()) {
-            let (blamed, linked) = (
-                conflicts.get(k).unwrap_or(&none),
-                links.get(k).unwrap_or(&none),
-            );
-            for (list, rule, slot) in [(blamed, ArcRule::Removed, 0), (linked, ArcRule::Fixed, 1)] {
+        for folder in folders {
+            for (list, rule, slot) in [
+                (&folder.blamed, ArcRule::Removed, 0),
+                (&folder.links, ArcRule::Fixed, 1),
+            ] {
                 let (out, seen) = &mut listed[slot];
                 for (line, entry) in &list.entries {
                     if let Some(k) = names.edge(list, *line, entry)? {
@@ -423,6 +419,14 @@ mod tests {
         }
     }
 
+    /// A `--model` folder's blamed pairs and links.
+    fn folder(path: &str, blamed: Vec<Vec<String>>, links: Vec<Vec<String>>) -> ModelFolder {
+        ModelFolder {
+            blamed: list(path, blamed),
+            links: list(path, links),
+        }
+    }
+
     /// The model check's pairs leave the network like forbidden pairs, and are listed once
     /// each whichever folders blamed them; a blamed pair that is no view-graph edge is listed and
     /// changes nothing.
@@ -431,14 +435,16 @@ mod tests {
         let (images, graph) = four_in_a_row();
         let name = |id: u32| images[id as usize - 1].name.clone();
         let overrides = Overrides {
-            model_conflicts: vec![
-                list(
+            model: vec![
+                folder(
                     "sparse",
                     vec![vec![name(2), name(3)], vec![name(1), name(4)]],
+                    vec![],
                 ),
-                list(
+                folder(
                     "sparse2",
                     vec![vec![name(1), name(4)], vec![name(3), name(4)]],
+                    vec![],
                 ),
             ],
             ..Overrides::default()
@@ -468,16 +474,13 @@ mod tests {
         let (images, graph) = four_in_a_row();
         let name = |id: u32| images[id as usize - 1].name.clone();
         let mut overrides = Overrides {
-            model_conflicts: vec![
-                list(
+            model: vec![
+                folder(
                     "sparse",
                     vec![vec![name(2), name(3)], vec![name(3), name(4)]],
+                    vec![],
                 ),
-                list("sparse2", vec![]),
-            ],
-            model_links: vec![
-                list("sparse", vec![]),
-                list("sparse2", vec![vec![name(3), name(2)]]),
+                folder("sparse2", vec![], vec![vec![name(3), name(2)]]),
             ],
             ..Overrides::default()
         };
@@ -490,9 +493,8 @@ mod tests {
         // A later folder's blame wins over an earlier folder's link.
         let mut later = overrides.clone();
         later
-            .model_conflicts
-            .push(list("sparse3", vec![vec![name(2), name(3)]]));
-        later.model_links.push(list("sparse3", vec![]));
+            .model
+            .push(folder("sparse3", vec![vec![name(2), name(3)]], vec![]));
         let resolved = later.resolve(&images, &graph, 15).unwrap();
         assert_eq!(resolved.edges[1], ArcRule::Removed);
         overrides.forbid_pairs = Some(list("forbid.txt", vec![vec![name(2), name(3)]]));

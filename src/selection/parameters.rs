@@ -12,7 +12,7 @@ use crate::costs::CostModel;
 use crate::flow::search::{Criteria, FlowRule, GivenCriteria};
 use crate::named::Named;
 use crate::priors::Prior;
-use crate::selection::arc_rules::{ArcRules, NameList, Overrides};
+use crate::selection::arc_rules::{ArcRules, ModelFolder, NameList, Overrides};
 use crate::selection::capture_order::{self, Order};
 use crate::selection::preset::Preset;
 use crate::selection::track_completion::Needs;
@@ -192,7 +192,7 @@ impl Parameters {
                 .transpose()
         };
         let rules = &self.arc_rules;
-        let (mut model_conflicts, mut model_links) = (Vec::new(), Vec::new());
+        let mut model = Vec::new();
         if !rules.model.is_empty() {
             // The database's side of the check, read once for every --model folder.
             let evidence = check::evidence::Evidence::load(db)?;
@@ -207,16 +207,17 @@ impl Parameters {
                         .map(|(k, [a, b])| (k + 1, vec![a, b]))
                         .collect(),
                 };
-                model_conflicts.push(list(found.blamed));
-                model_links.push(list(found.links));
+                model.push(ModelFolder {
+                    blamed: list(found.blamed),
+                    links: list(found.links),
+                });
             }
         }
         Ok(Overrides {
             keep_pairs: read(&rules.keep_pairs, true)?,
             forbid_pairs: read(&rules.forbid_pairs, true)?,
             forbid_images: read(&rules.forbid_images, false)?,
-            model_conflicts,
-            model_links,
+            model,
         })
     }
 }
