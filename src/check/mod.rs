@@ -248,6 +248,41 @@ pub struct ModelEvidence {
     pub links: Vec<[String; 2]>,
 }
 
+/// The check of a mapper's output: each model's, and the joins among its clean ones (only with
+/// the database's evidence).
+pub struct RunCheck<'e> {
+    /// Each model's check, in the order given.
+    pub models: Vec<ModelCheck<'e>>,
+    /// The clean models the database's matches place in one frame ([`join`]).
+    pub joins: Vec<join::Join>,
+}
+
+/// Checks every model of one mapper run and, with `evidence`, joins its clean ones.
+pub fn check_run<'e>(
+    models: &[SparseModel],
+    evidence: Option<&'e Evidence>,
+    settings: &CheckSettings,
+) -> Result<RunCheck<'e>> {
+    let checks = models
+        .iter()
+        .map(|m| check_model(m, evidence, settings))
+        .collect::<Result<Vec<_>>>()?;
+    let joins = match evidence {
+        Some(e) => {
+            let checked: Vec<_> = models
+                .iter()
+                .zip(checks.iter().map(|c| c.ghosted))
+                .collect();
+            join::join_models(&checked, e, settings)?
+        }
+        None => Vec::new(),
+    };
+    Ok(RunCheck {
+        models: checks,
+        joins,
+    })
+}
+
 /// The repair's evidence from the models of `dir` (a model folder or a mapper's output_path),
 /// checked with the database's `evidence`.
 pub fn model_evidence(
@@ -255,29 +290,23 @@ pub fn model_evidence(
     evidence: &Evidence,
     settings: &CheckSettings,
 ) -> Result<ModelEvidence> {
-    let mut blamed = std::collections::BTreeSet::new();
     let models = crate::colmap::model::model_dirs(dir)?
         .iter()
         .map(|d| crate::colmap::sparse::read_sparse_model(d))
         .collect::<Result<Vec<_>>>()?;
-    let mut verdicts = Vec::new();
-    for model in &models {
-        let checked = check_model(model, Some(evidence), settings)?;
-        verdicts.push(checked.ghosted);
-        let Some(worst) = checked.worst.filter(|_| checked.ghosted) else {
-            continue;
-        };
-        for p in worst.joining_pairs.iter().filter(|p| p.shared_points > 0) {
-            blamed.insert([p.image1.clone(), p.image2.clone()]);
+    let run = check_run(&models, Some(evidence), settings)?;
+    let mut blamed = std::collections::BTreeSet::new();
+    for checked in run.models.into_iter().filter(|c| c.ghosted) {
+        for p in checked.worst.iter().flat_map(|w| &w.joining_pairs) {
+            if p.shared_points > 0 {
+                blamed.insert([p.image1.clone(), p.image2.clone()]);
+            }
         }
     }
-    let checked: Vec<_> = models.iter().zip(verdicts).collect();
     let mut links = std::collections::BTreeSet::new();
-    for join in join::join_models(&checked, evidence, settings)? {
-        for l in join.links {
-            let (a, b) = (l.image1, l.image2);
-            links.insert(if a < b { [a, b] } else { [b, a] });
-        }
+    for l in run.joins.into_iter().flat_map(|j| j.links) {
+        let (a, b) = (l.image1, l.image2);
+        links.insert(if a < b { [a, b] } else { [b, a] });
     }
     Ok(ModelEvidence {
         blamed: blamed.into_iter().collect(),

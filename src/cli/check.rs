@@ -147,11 +147,10 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         .iter()
         .map(|dir| read_sparse_model(dir))
         .collect::<Result<Vec<_>>>()?;
+    let run = check::check_run(&models, evidence.as_ref(), &settings)?;
     let mut reports = Vec::new();
-    let mut verdicts = Vec::new();
-    for (k, (dir, model)) in dirs.iter().zip(&models).enumerate() {
-        let result = check::check_model(model, evidence.as_ref(), &settings)?;
-        println!("{}", verdict_line(dir, &result, settings.min_conflicts));
+    for (k, (dir, result)) in dirs.iter().zip(&run.models).enumerate() {
+        println!("{}", verdict_line(dir, result, settings.min_conflicts));
         if let (Some(plots), Some(views)) = (&args.plots, &result.views) {
             std::fs::create_dir_all(plots)
                 .with_context(|| format!("creating {}", plots.display()))?;
@@ -168,23 +167,15 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
                 &plots.join(format!("top_view_{k}.svg")),
             )?;
         }
-        verdicts.push(result.ghosted);
-        let mut value = serde_json::to_value(&result)?;
+        let mut value = serde_json::to_value(result)?;
         value["model"] = dir.display().to_string().into();
         reports.push(value);
     }
-    let ghosted = verdicts.iter().any(|g| *g);
+    let ghosted = run.models.iter().any(|c| c.ghosted);
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
-    let joins = match &evidence {
-        Some(e) => {
-            let checked: Vec<_> = models.iter().zip(verdicts.iter().copied()).collect();
-            check::join::join_models(&checked, e, &settings)?
-        }
-        None => Vec::new(),
-    };
     let mut joined = Vec::new();
-    for join in &joins {
+    for join in &run.joins {
         println!("{}", join_line(&dirs, join));
         let mut value = serde_json::to_value(join)?;
         value["model_paths"] = join
