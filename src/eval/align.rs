@@ -6,6 +6,7 @@
 //! neither hide how good the rest is nor tilt the fit away from it.
 
 use crate::colmap::model::ModelImage;
+use crate::geometry::similarity::nearest_rotation;
 pub use crate::geometry::similarity::Similarity;
 use anyhow::{bail, ensure, Result};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
@@ -171,16 +172,7 @@ fn fit_given_rotation(
 /// The rotation nearest (Frobenius) to the sum of the given ones.
 fn chordal_mean<'a>(rotations: impl Iterator<Item = &'a Rotation3<f64>>) -> Rotation3<f64> {
     let sum: Matrix3<f64> = rotations.map(|r| r.matrix()).sum();
-    let svd = sum.svd(true, true);
-    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
-    let mut d = Matrix3::identity();
-    if (u * v_t).determinant() < 0.0 {
-        // Flip the axis of the smallest singular value: the nearest proper rotation.
-        let sv = svd.singular_values;
-        let i = (0..3).min_by(|&a, &b| sv[a].total_cmp(&sv[b])).unwrap();
-        d[(i, i)] = -1.0;
-    }
-    Rotation3::from_matrix_unchecked(u * d * v_t)
+    nearest_rotation(&sum)
 }
 
 /// Scene extent used to make error thresholds scale-free: the largest distance between two

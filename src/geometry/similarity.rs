@@ -46,24 +46,14 @@ impl Similarity {
             covariance += t * f.transpose();
             variance += f.norm_squared();
         }
-        let svd = covariance.svd(true, true);
-        let (u, v_t) = (svd.u?, svd.v_t?);
-        let mut sorted = svd.singular_values.as_slice().to_vec();
+        let mut sorted = covariance.singular_values().as_slice().to_vec();
         sorted.sort_by(|a, b| b.total_cmp(a));
         if variance <= 1e-12 * (1.0 + mu_from.norm_squared()) || sorted[1] <= 1e-9 * sorted[0] {
             return None;
         }
-        // A reflection is flipped on the axis of the smallest singular value.
-        let mut d = Matrix3::identity();
-        let mut trace = svd.singular_values.sum();
-        if (u * v_t).determinant() < 0.0 {
-            let sv = svd.singular_values;
-            let i = (0..3).min_by(|&a, &b| sv[a].total_cmp(&sv[b]))?;
-            d[(i, i)] = -1.0;
-            trace -= 2.0 * sv[i];
-        }
-        let rotation = Rotation3::from_matrix_unchecked(u * d * v_t);
-        let scale = trace / variance;
+        let rotation = nearest_rotation(&covariance);
+        // Umeyama's trace(D S) is trace(R^T C): the covariance along the rotation.
+        let scale = (rotation.matrix().transpose() * covariance).trace() / variance;
         if !(scale.is_finite() && scale > 0.0) {
             return None;
         }
@@ -73,6 +63,21 @@ impl Similarity {
             translation: mu_to - scale * (rotation * mu_from),
         })
     }
+}
+
+/// The proper rotation nearest to `m` in the Frobenius norm: `U V^T` of its SVD, with the axis
+/// of the smallest singular value flipped where that would be a reflection. The rotation of a
+/// least-squares fit (of a covariance), and the chordal mean of rotations (of their sum).
+pub fn nearest_rotation(m: &Matrix3<f64>) -> Rotation3<f64> {
+    let svd = m.svd(true, true);
+    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let mut d = Matrix3::identity();
+    if (u * v_t).determinant() < 0.0 {
+        let sv = svd.singular_values;
+        let i = (0..3).min_by(|&a, &b| sv[a].total_cmp(&sv[b])).unwrap();
+        d[(i, i)] = -1.0;
+    }
+    Rotation3::from_matrix_unchecked(u * d * v_t)
 }
 
 #[cfg(test)]
