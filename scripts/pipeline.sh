@@ -89,8 +89,8 @@ map_and_eval full
 map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds
 last=pruned models=()
-# Every model is checked, the last turn's too; a turn runs where the model is ghosted, or where
-# its clean models can be joined (`check` prints "A + B: one scene (...)").
+# Every model is checked, the last turn's too; a turn runs where the check gives `prune --model`
+# something to act on (its report's `repair`: pairs a ghost blames, pairs that join clean models).
 for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   [ "${REPAIR:-0}" -gt 0 ] || break
   status=0
@@ -98,7 +98,8 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
     --report "$work/check_$last.json" >"$work/check_$last.txt" || status=$?
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
-  [ "$status" = 3 ] || grep -q ': one scene (' "$work/check_$last.txt" || break
+  python3 -c 'import json, sys; sys.exit(not any(json.load(open(sys.argv[1]))["repair"].values()))' \
+    "$work/check_$last.json" || break
   [ "$turn" -le "$REPAIR" ] || break
   models+=(--model "$work/sparse_$last")
   log "the $last model is ghosted or in pieces: prune --model (turn $turn), mapper again"

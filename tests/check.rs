@@ -278,6 +278,18 @@ fn the_repair_loop_makes_one_correct_model_of_the_halls_two_orbits() {
         })
         .collect();
     eprintln!("after {turns} turns: {last}\n{}", checks.join(""));
+    // The check's `repair` is what the next turn's prune acts on, pair for pair.
+    if turns > 0 {
+        let (check, prune) = (
+            read("check_pruned.json").unwrap(),
+            read("prune_repaired1.json").unwrap(),
+        );
+        assert_eq!(
+            check["repair"]["blamed"],
+            prune["overrides"]["model_conflicts"]
+        );
+        assert_eq!(check["repair"]["links"], prune["overrides"]["model_links"]);
+    }
     // The preset alone folds the hall; one model of 38 takes the join of the two orbits.
     if turns > 0 {
         assert!(

@@ -301,13 +301,15 @@ def scored_run(images, work, dbs, spec):
     if preset == "repair":
         result, models = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}"), []
         for turn in range(1, REPAIR_TURNS + 1):
+            report = result["sparse"] + ".check.json"
             checked = subprocess.run([VGSEL, "check", "--model", result["sparse"],
-                                      "--database_path", result["database"]], capture_output=True)
+                                      "--database_path", result["database"], "--report", report],
+                                     capture_output=True)
             if checked.returncode not in (0, 3):
                 sys.exit(f"lab-measure: check failed on {result['sparse']}: "
                          f"{checked.stderr.decode()}")
-            # Clean, and no clean models to join: the loop stops at this model.
-            if checked.returncode == 0 and b": one scene (" not in checked.stdout:
+            # Nothing for `prune --model` to act on: the loop stops at this model.
+            if not any(json.load(open(report))["repair"].values()):
                 break
             models += ["--model", result["sparse"]]
             result = measured(images, work, db, variant, order, kind, extra, None,

@@ -3,8 +3,8 @@
 # COLMAP 3.8's (colmap3.8), over several fresh matchings:
 # each run matches the rendered images (COLMAP 3.8 and pycolmap 4.2, as colmap4-mappers.sh),
 # prunes a copy (PRUNE_ARGS, default --preset disambiguation), maps it, runs `check` on the
-# model, and where check says ghosted (or joins the run's clean models: "A + B: one scene")
-# prunes again with --model and maps once more. Every model is scored against the ground truth.
+# model, and where check gives `prune --model` something to act on (its report's `repair`: a
+# ghost's blamed pairs, or pairs that join clean models) prunes again with --model and maps once more. Every model is scored against the ground truth.
 # Prints one row per run and mapper; writes WORKDIR/loop.json.
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
 # most [3], each passing every earlier model to `prune --model`.
@@ -52,9 +52,10 @@ for run in $(seq 1 "$runs"); do
         status=0
         "$bin" check --model "$model" --database_path "$db" \
           --report "$model.check.json" >"$model.check.txt" || status=$?
-        # Another turn where the model is ghosted, or its clean models can be joined.
-        { [ "$status" -eq 3 ] || grep -q ': one scene (' "$model.check.txt"; } &&
-          [ "$step" -le "$turns" ] || break
+        [ "$status" -eq 0 ] || [ "$status" -eq 3 ] || exit "$status"
+        # Another turn where the check gives `prune --model` something to act on.
+        python3 -c 'import json, sys; sys.exit(not any(json.load(open(sys.argv[1]))["repair"].values()))' \
+          "$model.check.json" && [ "$step" -le "$turns" ] || break
         models+=(--model "$model")
         # shellcheck disable=SC2086
         "$bin" prune -q ${PRUNE_ARGS:---preset disambiguation} --database_path "$db" "${models[@]}"

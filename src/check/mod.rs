@@ -235,8 +235,9 @@ fn describe(
     }
 }
 
-/// What a mapper's output says about the database's pairs (`prune --model DIR`).
-#[derive(Clone, Debug, Default, PartialEq)]
+/// What a mapper's output says about the database's pairs (`prune --model DIR`; `repair` in
+/// `check`'s report).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct ModelEvidence {
     /// In each model the check finds ghosted, the pairs across its worst split that share 3D
     /// points: the pairs whose matches glued one copy onto the other. Pairs across the split that
@@ -283,6 +284,31 @@ pub fn check_run<'e>(
     })
 }
 
+impl RunCheck<'_> {
+    /// What `prune --model` takes from this run: the blamed pairs of its ghosted models and
+    /// the pairs linking the clean models it joins. Empty when a repair turn has nothing to act
+    /// on (the loop's scripts stop there).
+    pub fn evidence(&self) -> ModelEvidence {
+        let mut blamed = std::collections::BTreeSet::new();
+        for checked in self.models.iter().filter(|c| c.ghosted) {
+            for p in checked.worst.iter().flat_map(|w| &w.joining_pairs) {
+                if p.shared_points > 0 {
+                    blamed.insert([p.image1.clone(), p.image2.clone()]);
+                }
+            }
+        }
+        let mut links = std::collections::BTreeSet::new();
+        for l in self.joins.iter().flat_map(|j| &j.links) {
+            let (a, b) = (l.image1.clone(), l.image2.clone());
+            links.insert(if a < b { [a, b] } else { [b, a] });
+        }
+        ModelEvidence {
+            blamed: blamed.into_iter().collect(),
+            links: links.into_iter().collect(),
+        }
+    }
+}
+
 /// The repair's evidence from the models of `dir` (a model folder or a mapper's output_path),
 /// checked with the database's `evidence`.
 pub fn model_evidence(
@@ -294,24 +320,7 @@ pub fn model_evidence(
         .iter()
         .map(|d| crate::colmap::sparse::read_sparse_model(d))
         .collect::<Result<Vec<_>>>()?;
-    let run = check_run(&models, Some(evidence), settings)?;
-    let mut blamed = std::collections::BTreeSet::new();
-    for checked in run.models.into_iter().filter(|c| c.ghosted) {
-        for p in checked.worst.iter().flat_map(|w| &w.joining_pairs) {
-            if p.shared_points > 0 {
-                blamed.insert([p.image1.clone(), p.image2.clone()]);
-            }
-        }
-    }
-    let mut links = std::collections::BTreeSet::new();
-    for l in run.joins.into_iter().flat_map(|j| j.links) {
-        let (a, b) = (l.image1, l.image2);
-        links.insert(if a < b { [a, b] } else { [b, a] });
-    }
-    Ok(ModelEvidence {
-        blamed: blamed.into_iter().collect(),
-        links: links.into_iter().collect(),
-    })
+    Ok(check_run(&models, Some(evidence), settings)?.evidence())
 }
 
 #[cfg(test)]

@@ -187,7 +187,13 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         joined.push(value);
     }
     if let Some(path) = &args.report {
-        let report = serde_json::json!({ "ghosted": ghosted, "settings": settings, "models": reports, "joins": joined });
+        let report = serde_json::json!({
+            "ghosted": ghosted,
+            "settings": settings,
+            "models": reports,
+            "joins": joined,
+            "repair": run.evidence(),
+        });
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
     }
