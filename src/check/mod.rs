@@ -89,15 +89,22 @@ pub fn check_model<'e>(
     let pairs = evidence.map(|e| &e.pairs);
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
-    let candidates = candidates(&views, &covisibility, settings);
-    // The worst split: the highest score among those with enough conflicts to be judged, else
-    // the highest score (reported, never ghosted).
-    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, score(c, settings));
-    let mut worst: Option<(Vec<bool>, Counts)> = None;
-    for side in &candidates {
-        let counts = conflict::count(&views, side, &settings.conflict);
-        if worst.as_ref().is_none_or(|w| rank(&counts) > rank(&w.1)) {
-            worst = Some((side.clone(), counts));
+    let groups = candidates(&views, &covisibility, settings);
+    let mut worst = worst_split(&views, &groups, settings);
+    let mut splits_scored = groups.len();
+    // An image registered alone onto the other copy (a street's camera one building off) is no
+    // split of groups; where no such split is ghosted, each image alone is scored too.
+    if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
+        let mut singles = Vec::new();
+        for v in 0..n {
+            splits::push_split(&mut singles, (0..n).map(|w| w == v).collect());
+        }
+        singles.retain(|side| !groups.contains(side));
+        splits_scored += singles.len();
+        if let Some(single) = worst_split(&views, &singles, settings) {
+            if is_ghost(&single.1, settings) {
+                worst = Some(single);
+            }
         }
     }
     let (side, split) = match worst {
@@ -109,19 +116,42 @@ pub fn check_model<'e>(
         None => (vec![false; n], None),
     };
     let score = split.as_ref().map_or(0.0, |s| s.score);
-    let ghosted = split.as_ref().is_some_and(|s| {
-        s.score >= settings.threshold && s.counts.conflicting >= settings.min_conflicts
-    });
+    let ghosted = split
+        .as_ref()
+        .is_some_and(|s| is_ghost(&s.counts, settings));
     Ok(ModelCheck {
         images: n,
         points: views.points.len(),
-        splits_scored: candidates.len(),
+        splits_scored,
         ghosted,
         score,
         worst: split,
         side,
         views: Some(views),
     })
+}
+
+/// The verdict on a split's counts: its score reaches the threshold, on enough conflicts.
+fn is_ghost(counts: &Counts, settings: &CheckSettings) -> bool {
+    score(counts, settings) >= settings.threshold && counts.conflicting >= settings.min_conflicts
+}
+
+/// The worst of `splits`: the highest score among those with enough conflicts to be judged,
+/// else the highest score (reported, never ghosted).
+fn worst_split(
+    views: &Views,
+    splits: &[Vec<bool>],
+    settings: &CheckSettings,
+) -> Option<(Vec<bool>, Counts)> {
+    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, score(c, settings));
+    let mut worst: Option<(Vec<bool>, Counts)> = None;
+    for side in splits {
+        let counts = conflict::count(views, side, &settings.conflict);
+        if worst.as_ref().is_none_or(|w| rank(&counts) > rank(&w.1)) {
+            worst = Some((side.clone(), counts));
+        }
+    }
+    worst
 }
 
 /// A link between two images agrees when at least this many samples were judged...
