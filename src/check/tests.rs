@@ -111,14 +111,21 @@ fn ghosted_model() -> SparseModel {
     ghosted_model_at(0.0)
 }
 
+/// Two walls at the same place, textured differently (`count` points each), and a small object
+/// in front of them (300 points at z = 4.5).
+fn two_walls_and_an_object(rng: &mut Lcg, count: usize) -> [Vec<(u64, [f64; 3])>; 3] {
+    let first = wall(rng, count, 0);
+    let second = wall(rng, count, 10_000);
+    let object = (0..300)
+        .map(|k| (20_000 + k, [rng.next() - 0.5, rng.next() - 0.5, 4.5]))
+        .collect();
+    [first, second, object]
+}
+
 /// [`ghosted_model`] with the second wall's cameras moved back by `back`.
 fn ghosted_model_at(back: f64) -> SparseModel {
     let mut rng = Lcg(11);
-    let first = wall(&mut rng, 2000, 0);
-    let second = wall(&mut rng, 2000, 10_000);
-    let object: Vec<(u64, [f64; 3])> = (0..300)
-        .map(|k| (20_000 + k, [rng.next() - 0.5, rng.next() - 0.5, 4.5]))
-        .collect();
+    let [first, second, object] = two_walls_and_an_object(&mut rng, 2000);
     let mut images = Vec::new();
     for k in 0..12u32 {
         let mut seen = object.clone();
@@ -132,13 +139,7 @@ fn ghosted_model_at(back: f64) -> SparseModel {
             &mut rng,
         ));
     }
-    let all: Vec<_> = first
-        .iter()
-        .chain(&second)
-        .chain(&object)
-        .copied()
-        .collect();
-    model(images, &all)
+    model(images, &[first, second, object].concat())
 }
 
 #[test]
@@ -174,11 +175,7 @@ fn a_ghosted_model_is_found_with_its_two_groups() {
 /// otherwise it saw the first wall too.
 fn one_image_model(misplaced: bool) -> SparseModel {
     let mut rng = Lcg(13);
-    let first = wall(&mut rng, 3000, 0);
-    let second = wall(&mut rng, 3000, 10_000);
-    let object: Vec<(u64, [f64; 3])> = (0..300)
-        .map(|k| (20_000 + k, [rng.next() - 0.5, rng.next() - 0.5, 4.5]))
-        .collect();
+    let [first, second, object] = two_walls_and_an_object(&mut rng, 3000);
     let mut seen = first.clone();
     seen.extend(&object);
     let mut images: Vec<SparseImage> = (0..12)
@@ -191,13 +188,7 @@ fn one_image_model(misplaced: bool) -> SparseModel {
     };
     own.extend(&object);
     images.push(image(13, 0.25, &own, 0.6, &mut rng));
-    let all: Vec<_> = first
-        .iter()
-        .chain(&second)
-        .chain(&object)
-        .copied()
-        .collect();
-    model(images, &all)
+    model(images, &[first, second, object].concat())
 }
 
 /// One image registered onto the other copy is found alone, though no split of groups (three
