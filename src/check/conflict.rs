@@ -95,6 +95,38 @@ pub fn count(views: &Views, side: &[bool], settings: &ConflictSettings) -> Count
     counts
 }
 
+/// [`count`] of the split that puts view `b` alone in one group, in one pass over the points
+/// instead of one per view: what `b` saw, judged in every other view; what the others saw and
+/// `b` did not, judged in `b`.
+pub fn count_alone(views: &Views, b: usize, settings: &ConflictSettings) -> Counts {
+    let mut counts = Counts::default();
+    for (k, track) in views.observers.iter().enumerate() {
+        match track.binary_search(&b) {
+            Ok(at) => {
+                if track.len() > 1 {
+                    // Seen by b and by others: seen in b, and in each other observer.
+                    counts.seen += track.len();
+                }
+                let from = [(b, views.observed_at[k][at])];
+                let ours = |j: usize| views.observers[j].binary_search(&b).is_ok();
+                for v in (0..views.views.len()).filter(|v| track.binary_search(v).is_err()) {
+                    counts.add(judge(views, k, v, &from, &ours, settings));
+                }
+            }
+            Err(_) => {
+                let from: Vec<(usize, u32)> = track
+                    .iter()
+                    .copied()
+                    .zip(views.observed_at[k].iter().copied())
+                    .collect();
+                let ours = |j: usize| views.observers[j].iter().any(|&v| v != b);
+                counts.add(judge(views, k, b, &from, &ours, settings));
+            }
+        }
+    }
+    counts
+}
+
 /// How a sample ended.
 enum Sample {
     /// Only the image's own group's structure near the projection.

@@ -90,18 +90,27 @@ pub fn check_model<'e>(
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
     let groups = candidates(&views, &covisibility, settings);
-    let mut worst = worst_split(&views, &groups, settings);
+    let scored = groups.iter().map(|side| {
+        (
+            side.clone(),
+            conflict::count(&views, side, &settings.conflict),
+        )
+    });
+    let mut worst = worst_split(scored, settings);
     let mut splits_scored = groups.len();
     // An image registered alone onto the other copy (a street's camera one building off) is no
     // split of groups; where no such split is ghosted, each image alone is scored too.
     if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
-        let mut singles = Vec::new();
-        for v in 0..n {
-            splits::push_split(&mut singles, (0..n).map(|w| w == v).collect());
-        }
-        singles.retain(|side| !groups.contains(side));
+        let singles: Vec<(usize, Vec<bool>)> = (0..n)
+            .map(|v| (v, splits::normalised((0..n).map(|w| w == v).collect())))
+            .filter(|(_, side)| !groups.contains(side))
+            .collect();
         splits_scored += singles.len();
-        if let Some(single) = worst_split(&views, &singles, settings) {
+        let scored = singles.into_iter().map(|(v, side)| {
+            let counts = conflict::count_alone(&views, v, &settings.conflict);
+            (side, counts)
+        });
+        if let Some(single) = worst_split(scored, settings) {
             if is_ghost(&single.1, settings) {
                 worst = Some(single);
             }
@@ -136,19 +145,17 @@ fn is_ghost(counts: &Counts, settings: &CheckSettings) -> bool {
     score(counts, settings) >= settings.threshold && counts.conflicting >= settings.min_conflicts
 }
 
-/// The worst of `splits`: the highest score among those with enough conflicts to be judged,
-/// else the highest score (reported, never ghosted).
+/// The worst of the `scored` splits: the highest score among those with enough conflicts to be
+/// judged, else the highest score (reported, never ghosted).
 fn worst_split(
-    views: &Views,
-    splits: &[Vec<bool>],
+    scored: impl Iterator<Item = (Vec<bool>, Counts)>,
     settings: &CheckSettings,
 ) -> Option<(Vec<bool>, Counts)> {
     let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, score(c, settings));
     let mut worst: Option<(Vec<bool>, Counts)> = None;
-    for side in splits {
-        let counts = conflict::count(views, side, &settings.conflict);
+    for (side, counts) in scored {
         if worst.as_ref().is_none_or(|w| rank(&counts) > rank(&w.1)) {
-            worst = Some((side.clone(), counts));
+            worst = Some((side, counts));
         }
     }
     worst

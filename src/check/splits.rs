@@ -104,12 +104,18 @@ pub fn candidate_splits(n: usize, tree: &[(usize, usize)], min_group: usize) -> 
     out
 }
 
-/// Adds `side` to `out` unless it is there already, in the one form every split is kept in:
-/// the model's first image in the `false` group, so that a split and its mirror are one.
-pub fn push_split(out: &mut Vec<Vec<bool>>, mut side: Vec<bool>) {
+/// The one form every split is kept in: the model's first image in the `false` group, so that a
+/// split and its mirror are one.
+pub fn normalised(mut side: Vec<bool>) -> Vec<bool> {
     if side[0] {
         side.iter_mut().for_each(|s| *s = !*s);
     }
+    side
+}
+
+/// Adds `side` to `out`, [`normalised`], unless it is there already.
+pub fn push_split(out: &mut Vec<Vec<bool>>, side: Vec<bool>) {
+    let side = normalised(side);
     if !out.contains(&side) {
         out.push(side);
     }

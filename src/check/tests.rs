@@ -204,6 +204,29 @@ fn an_image_registered_onto_the_other_copy_is_found_alone() {
     assert!(!check.ghosted, "score {}", check.score);
 }
 
+/// The one-pass count of an image alone is the general count of that split, image by image, on
+/// models with and without a ghost, and with the database's matches.
+#[test]
+fn an_image_alone_is_counted_as_the_general_split_counts_it() {
+    let (split_tracks, evidence) = split_tracks_model();
+    let cases = [
+        (one_image_model(true), None),
+        (ghosted_model(), None),
+        (split_tracks, Some(&evidence)),
+    ];
+    for (model, evidence) in &cases {
+        let views = Views::new(model, DEFAULT_SETTINGS.conflict.radius, *evidence).unwrap();
+        let n = views.views.len();
+        for v in 0..n {
+            let side: Vec<bool> = (0..n).map(|w| w == v).collect();
+            let general = conflict::count(&views, &side, &DEFAULT_SETTINGS.conflict);
+            let alone = conflict::count_alone(&views, v, &DEFAULT_SETTINGS.conflict);
+            assert_eq!(alone, general, "image {v}");
+            assert!(general.conflicting + general.agreeing > 0, "image {v}");
+        }
+    }
+}
+
 #[test]
 fn the_check_is_deterministic() {
     let a = check_model(&ghosted_model(), None, &DEFAULT_SETTINGS).unwrap();
