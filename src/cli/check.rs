@@ -82,6 +82,9 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
             w.groups[0].len(),
             w.groups[1].len()
         );
+        if let Some(one) = w.groups.iter().find(|g| g.len() == 1) {
+            line += &format!(": {} alone", one[0]);
+        }
         if judged < min_conflicts {
             line += "; too few samples to find a ghost";
         }
@@ -241,5 +244,18 @@ mod tests {
         );
         let line = verdict_line(Path::new("sparse/0"), &checked(2, 100), 30);
         assert!(!line.contains("too few"), "{line}");
+    }
+
+    /// An image alone in its group is named on the verdict line.
+    #[test]
+    fn an_image_alone_is_named() {
+        let mut c = checked(600, 400);
+        c.ghosted = true;
+        c.worst.as_mut().unwrap().groups[1] = vec!["0010.png".into()];
+        let line = verdict_line(Path::new("sparse/0"), &c, 30);
+        assert!(
+            line.contains("groups of 3 and 1 images: 0010.png alone; 0 joining pairs"),
+            "{line}"
+        );
     }
 }
