@@ -2,7 +2,8 @@
 //! onto each other), and where? Without ground truth, from the model and its database alone.
 //!
 //! Every image of a model is a view ([`views`]); the co-visibility graph and the links that
-//! agree offer candidate splits into two groups ([`splits`]); each split is scored by
+//! agree offer candidate splits into two groups ([`splits`]), and where none is ghosted each
+//! image alone against the rest is a candidate too; each split is scored by
 //! conflicting observations ([`conflict`]); a model whose worst split's score (its conflict
 //! ratio, with a prior of agreeing samples) reaches the threshold is ghosted, and the report
 //! names the two groups and the database pairs that join them. docs/check.md gives the method,
