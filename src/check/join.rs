@@ -30,6 +30,10 @@ use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
 
+/// A clean model's group is misplaced when the placement its matches give moves its points by
+/// more than this fraction of the model's spread (median): 5%, the evaluation's tolerance for a
+/// correct camera. The correct models measured move by a fraction of a percent.
+pub const MISPLACED_DISTANCE: f64 = 0.05;
 /// Placements tried per pair of models, most supported first.
 pub const PLACEMENTS: usize = 3;
 /// Random minimal samples (three correspondences) drawn per placement.
@@ -65,7 +69,8 @@ pub struct Link {
 /// Two models joined by a placement that does not conflict.
 #[derive(Clone, Debug, Serialize)]
 pub struct Join {
-    /// The two models, as indices of the checked folders.
+    /// The two models, as indices of the checked folders (a model's own index twice for its
+    /// [`misplaced`] group).
     pub models: [usize; 2],
     /// Correspondences between the two models.
     pub correspondences: usize,
@@ -93,6 +98,17 @@ pub struct Placement {
     pub rotation: [[f64; 3]; 3],
     /// Translation.
     pub translation: [f64; 3],
+}
+
+impl From<&Placement> for Similarity {
+    fn from(p: &Placement) -> Similarity {
+        let r = nalgebra::Matrix3::from_fn(|i, j| p.rotation[i][j]);
+        Similarity {
+            scale: p.scale,
+            rotation: nalgebra::Rotation3::from_matrix_unchecked(r),
+            translation: Vector3::from(p.translation),
+        }
+    }
 }
 
 impl From<&Similarity> for Placement {
@@ -127,6 +143,66 @@ pub fn join_models(
         }
     }
     Ok(joins)
+}
+
+/// Model `k`'s two `groups` (its worst split) placed as two models are: where the database's
+/// matches put the second group elsewhere than the model does (by the placement [`join_models`]
+/// would join them with, moving its points by more than [`MISPLACED_DISTANCE`] of the model's
+/// spread), the model misplaced it as a whole. A global mapper with few true links left
+/// between two copies can do this: the hall's second orbit, turned 17 degrees (docs/check.md).
+pub fn misplaced(
+    k: usize,
+    model: &SparseModel,
+    groups: &[Vec<String>; 2],
+    evidence: &Evidence,
+    settings: &CheckSettings,
+) -> anyhow::Result<Option<Join>> {
+    if groups.iter().any(|g| g.len() < settings.min_group) {
+        return Ok(None);
+    }
+    let [a, b] = [&groups[0], &groups[1]].map(|g| subset(model, g));
+    let Some(join) = join_two([k, k], [&a, &b], evidence, settings)? else {
+        return Ok(None);
+    };
+    let placement = Similarity::from(&join.placement);
+    let mut moved: Vec<f64> = b
+        .points
+        .values()
+        .map(|p| {
+            let x = Vector3::new(p[0], p[1], p[2]);
+            (placement.apply(&x) - x).norm()
+        })
+        .collect();
+    if moved.is_empty() {
+        return Ok(None);
+    }
+    let mid = moved.len() / 2;
+    let median = *moved.select_nth_unstable_by(mid, f64::total_cmp).1;
+    Ok((median > MISPLACED_DISTANCE * spread(model)).then_some(join))
+}
+
+/// `model`'s images named in `names`, with the points they observe.
+fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
+    let images: Vec<SparseImage> = model
+        .images
+        .iter()
+        .filter(|im| names.contains(&im.image.name))
+        .cloned()
+        .collect();
+    let ids: BTreeSet<u64> = images
+        .iter()
+        .flat_map(|im| im.points2d.iter().filter_map(|p| p.point3d_id))
+        .collect();
+    SparseModel {
+        cameras: model.cameras.clone(),
+        points: model
+            .points
+            .iter()
+            .filter(|(id, _)| ids.contains(id))
+            .map(|(id, p)| (*id, *p))
+            .collect(),
+        images,
+    }
 }
 
 /// The join of models `[a, b]` (their indices `models`): the first placement of `b` in `a`'s

@@ -71,12 +71,22 @@ pub struct ModelCheck<'e> {
     pub score: f64,
     /// The worst split, if the model could be split at all.
     pub worst: Option<Split>,
+    /// With the database: the worst split of a clean model whose second group the database's
+    /// matches place elsewhere than the model does ([`join::misplaced`]). The model is wrong.
+    pub misplaced: Option<join::Join>,
     /// Which group each image is in (0 or 1) for the worst split, by image name.
     #[serde(skip)]
     pub side: Vec<bool>,
     /// The views (for plots).
     #[serde(skip)]
     pub views: Option<Views<'e>>,
+}
+
+impl ModelCheck<'_> {
+    /// Ghosted, or a group of it misplaced: the model is wrong where the check can tell.
+    pub fn wrong(&self) -> bool {
+        self.ghosted || self.misplaced.is_some()
+    }
 }
 
 /// Checks one model, with the database's evidence if there is one (without: joining pairs are
@@ -136,6 +146,7 @@ pub fn check_model<'e>(
         ghosted,
         score,
         worst: split,
+        misplaced: None,
         side,
         views: Some(views),
     })
@@ -283,7 +294,8 @@ pub struct ModelEvidence {
     /// mapper could not use (measured on the demo scene: docs/check.md). Sorted.
     pub blamed: Vec<[String; 2]>,
     /// The pairs that link clean models the database's matches place in one frame without a
-    /// conflict ([`join`]): what the mapper needs to make one model of them. Sorted.
+    /// conflict ([`join`]), and the two groups of a model that misplaced one of them
+    /// ([`join::misplaced`]): what the mapper needs to place them right. Sorted.
     pub links: Vec<[String; 2]>,
 }
 
@@ -296,21 +308,29 @@ pub struct RunCheck<'e> {
     pub joins: Vec<join::Join>,
 }
 
-/// Checks every model of one mapper run and, with `evidence`, joins its clean ones.
+/// Checks every model of one mapper run and, with `evidence`, places the two groups of each
+/// clean one ([`join::misplaced`]) and joins the models still clean.
 pub fn check_run<'e>(
     models: &[SparseModel],
     evidence: Option<&'e Evidence>,
     settings: &CheckSettings,
 ) -> Result<RunCheck<'e>> {
-    let checks = models
+    let mut checks = models
         .iter()
         .map(|m| check_model(m, evidence, settings))
         .collect::<Result<Vec<_>>>()?;
+    if let Some(e) = evidence {
+        for (k, (model, c)) in models.iter().zip(&mut checks).enumerate() {
+            if let (false, Some(worst)) = (c.ghosted, &c.worst) {
+                c.misplaced = join::misplaced(k, model, &worst.groups, e, settings)?;
+            }
+        }
+    }
     let joins = match evidence {
         Some(e) => {
             let checked: Vec<_> = models
                 .iter()
-                .zip(checks.iter().map(|c| c.ghosted))
+                .zip(checks.iter().map(ModelCheck::wrong))
                 .collect();
             join::join_models(&checked, e, settings)?
         }
@@ -336,7 +356,8 @@ impl RunCheck<'_> {
             }
         }
         let mut links = std::collections::BTreeSet::new();
-        for l in self.joins.iter().flat_map(|j| &j.links) {
+        let misplaced = self.models.iter().filter_map(|c| c.misplaced.as_ref());
+        for l in self.joins.iter().chain(misplaced).flat_map(|j| &j.links) {
             let (a, b) = (l.image1.clone(), l.image2.clone());
             links.insert(if a < b { [a, b] } else { [b, a] });
         }

@@ -457,14 +457,14 @@ fn joins_of_a_split(model: &SparseModel, in_b: impl Fn(&SparseImage) -> bool) ->
     join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap()
 }
 
+const HALL_OFFSET: u64 = 100_000;
+
 /// Like the hall design: two identical objects in front of one wall, six cameras walking past
-/// each, mapped as two models in their own frames. The database matches each first-object view
-/// to the second-object view from the same spot on the objects (false, and the most), and the
-/// views that overlap on the wall (true). The false matches' placement conflicts; the true one
-/// joins the models, and only pairs that overlap on the wall link them.
-#[test]
-fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_refuted() {
-    const OFFSET: u64 = 100_000;
+/// each, mapped as two models (the second in another frame, [`elsewhere`]). The database
+/// matches each first-object view to the second-object view from the same spot on the objects
+/// (false, and the most), and the views that overlap on the wall (true).
+fn hall_like() -> (SparseModel, SparseModel, Evidence) {
+    const OFFSET: u64 = HALL_OFFSET;
     let mut rng = Lcg(5);
     let wall: Vec<(u64, [f64; 3])> = (0..1500)
         .map(|k| (k, [12.0 * rng.next() - 6.0, 4.0 * rng.next() - 2.0, 5.0]))
@@ -507,18 +507,31 @@ fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_ref
         let m = evidence.matches.get_mut(&key).unwrap();
         m.extend(oa.iter().filter_map(|(p, &x)| ob.get(p).map(|&y| [x, y])));
     }
+    (a, b, evidence)
+}
+
+/// [`elsewhere`] undone: the hall-like second model's frame back to the scene's.
+fn back_from_elsewhere() -> Similarity {
+    Similarity {
+        scale: 1.0 / elsewhere().scale,
+        rotation: elsewhere().rotation.inverse(),
+        translation: -(elsewhere().rotation.inverse() * elsewhere().translation)
+            / elsewhere().scale,
+    }
+}
+
+/// The hall-like two models: the false matches' placement conflicts; the true one joins the
+/// models, and only pairs that overlap on the wall link them.
+#[test]
+fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_refuted() {
+    let (a, b, evidence) = hall_like();
     let joins =
         join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap();
     assert_eq!(joins.len(), 1, "{joins:?}");
     let join = &joins[0];
     assert_eq!(join.refuted, 1);
     // The placement is the true one: b's frame back to the scene's, as a's is.
-    let back = Similarity {
-        scale: 1.0 / elsewhere().scale,
-        rotation: elsewhere().rotation.inverse(),
-        translation: -(elsewhere().rotation.inverse() * elsewhere().translation)
-            / elsewhere().scale,
-    };
+    let back = back_from_elsewhere();
     let p = &join.placement;
     assert!((p.scale - back.scale).abs() < 1e-6 * back.scale, "{p:?}");
     assert!(
@@ -531,5 +544,45 @@ fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_ref
         let [ia, ib] = [&l.image1, &l.image2].map(|n| n[..4].parse::<u32>().unwrap());
         assert!(ib != ia + 6, "a twin pair links: {l:?}");
         assert!(l.agreeing * 2 >= l.correspondences, "{l:?}");
+    }
+}
+
+/// The hall-like two models as one, the second group put back right or turned and carried off
+/// as a whole (what the global mapper did to the hall's second orbit): only the misplaced one
+/// is called so, and its links are the true pairs that place it back.
+#[test]
+fn a_group_the_database_places_elsewhere_is_misplaced() {
+    let (a, b, evidence) = hall_like();
+    let turned = Similarity {
+        scale: 1.4,
+        rotation: nalgebra::Rotation3::from_euler_angles(0.0, 0.3, 0.0),
+        translation: Vector3::new(30.0, 0.0, -20.0),
+    };
+    let wrong = Similarity {
+        scale: turned.scale * back_from_elsewhere().scale,
+        rotation: turned.rotation * back_from_elsewhere().rotation,
+        translation: turned.scale * (turned.rotation * back_from_elsewhere().translation)
+            + turned.translation,
+    };
+    for (placement, misplaced) in [(back_from_elsewhere(), false), (wrong, true)] {
+        let one = join::put_together(&a, &b, &placement).0;
+        let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+        let c = &run.models[0];
+        assert!(!c.ghosted, "score {}", c.score);
+        assert_eq!(c.misplaced.is_some(), misplaced, "{:?}", c.misplaced);
+        assert_eq!(c.wrong(), misplaced);
+        if let Some(m) = &c.misplaced {
+            assert_eq!(m.models, [0, 0]);
+            assert!(
+                (m.placement.scale * turned.scale - 1.0).abs() < 1e-6,
+                "{m:?}"
+            );
+            assert!(!m.links.is_empty());
+            for l in &m.links {
+                let [ia, ib] = [&l.image1, &l.image2].map(|n| n[..4].parse::<u32>().unwrap());
+                assert!(ia.abs_diff(ib) != 6, "a twin pair links: {l:?}");
+            }
+            assert_eq!(run.evidence().links.len(), m.links.len());
+        }
     }
 }

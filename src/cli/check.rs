@@ -1,5 +1,5 @@
 //! `check`: is a reconstruction ghosted, and where? One line per model, a JSON report, a top
-//! view per model, and an exit status a pipeline can branch on (3: ghosted).
+//! view per model, and an exit status a pipeline can branch on (3: ghosted or misplaced).
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -10,7 +10,7 @@ use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
 use vgsel_colmap::colmap::sparse::read_sparse_model;
 
-/// Exit status of a check that found a ghosted model.
+/// Exit status of a check that found a ghosted model, or one with a misplaced group.
 pub const EXIT_GHOSTED: u8 = 3;
 
 #[derive(Args)]
@@ -72,7 +72,11 @@ impl CheckArgs {
 /// The line a model gets: its verdict, score and groups; a clean model whose worst split had
 /// fewer judged samples than `min_conflicts` says so, as no ghost could have been found there.
 fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
-    let what = if c.ghosted { "GHOSTED" } else { "clean" };
+    let what = match (c.ghosted, &c.misplaced) {
+        (true, _) => "GHOSTED",
+        (false, Some(_)) => "MISPLACED",
+        (false, None) => "clean",
+    };
     let mut line = format!("{}: {what} (score {:.2}", dir.display(), c.score);
     if let Some(w) = &c.worst {
         let judged = w.counts.conflicting + w.counts.agreeing;
@@ -85,24 +89,42 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         if let Some(one) = w.groups.iter().find(|g| g.len() == 1) {
             line += &format!(": {} alone", one[0]);
         }
-        if judged < min_conflicts {
+        if judged < min_conflicts && c.misplaced.is_none() {
             line += "; too few samples to find a ghost";
         }
+        if let Some(m) = &c.misplaced {
+            let r = &m.placement.rotation;
+            let angle = ((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0).clamp(-1.0, 1.0);
+            line += &format!(
+                "; the database's matches place the second group {:.0}\u{b0} turned, scaled {:.2} \
+                 (by {} of {} correspondences, after {} refuted); {} pairs link them, e.g. {}",
+                angle.acos().to_degrees(),
+                m.placement.scale,
+                m.support,
+                m.correspondences,
+                m.refuted,
+                m.links.len(),
+                examples(m.links.iter().map(|l| (&l.image1, &l.image2)))
+            );
+        }
         if c.ghosted {
-            let pairs: Vec<String> = w
-                .joining_pairs
-                .iter()
-                .take(3)
-                .map(|p| format!("{}-{}", p.image1, p.image2))
-                .collect();
             line += &format!(
                 "; {} joining pairs, e.g. {}",
                 w.joining_pairs.len(),
-                pairs.join(" ")
+                examples(w.joining_pairs.iter().map(|p| (&p.image1, &p.image2)))
             );
         }
     }
     line + ")"
+}
+
+/// The first three `pairs` as `a-b c-d e-f`.
+fn examples<'a>(pairs: impl Iterator<Item = (&'a String, &'a String)>) -> String {
+    pairs
+        .take(3)
+        .map(|(a, b)| format!("{a}-{b}"))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// The line a join gets: the two models, how many pairs link them and how well they agree.
@@ -118,16 +140,12 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
         j.score,
         j.counts.conflicting,
         j.links.len(),
-        j.links
-            .iter()
-            .take(3)
-            .map(|l| format!("{}-{}", l.image1, l.image2))
-            .collect::<Vec<_>>()
-            .join(" ")
+        examples(j.links.iter().map(|l| (&l.image1, &l.image2)))
     )
 }
 
-/// Runs the check; Ok(true) when some model is ghosted. `quiet` silences the note on stderr.
+/// Runs the check; Ok(true) when some model is wrong (ghosted or misplaced). `quiet` silences
+/// the note on stderr.
 pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     let settings = args.settings();
     let evidence = match &args.database_path {
@@ -160,7 +178,11 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
             let title = format!(
                 "{}: {} (score {:.2})",
                 dir.display(),
-                if result.ghosted { "ghosted" } else { "clean" },
+                match (result.ghosted, result.misplaced.is_some()) {
+                    (true, _) => "ghosted",
+                    (false, true) => "misplaced",
+                    (false, false) => "clean",
+                },
                 result.score
             );
             check::plot::top_view(
@@ -175,6 +197,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         reports.push(value);
     }
     let ghosted = run.models.iter().any(|c| c.ghosted);
+    let misplaced = run.models.iter().any(|c| c.misplaced.is_some());
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
     let mut joined = Vec::new();
@@ -192,6 +215,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     if let Some(path) = &args.report {
         let report = serde_json::json!({
             "ghosted": ghosted,
+            "misplaced": misplaced,
             "settings": settings,
             "models": reports,
             "joins": joined,
@@ -200,7 +224,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    Ok(ghosted)
+    Ok(ghosted || misplaced)
 }
 
 #[cfg(test)]
@@ -227,6 +251,7 @@ mod tests {
                 score: 0.0,
                 joining_pairs: Vec::new(),
             }),
+            misplaced: None,
             side: Vec::new(),
             views: None,
         }
