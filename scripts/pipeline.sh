@@ -17,8 +17,9 @@
 #   SINGLE_CAMERA   one camera for all images [1]
 #   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
 #   REPAIR          N > 0: the repair loop (docs/check.md), at most N turns: `vgsel-colmap
-#                   check` on the last model, and where it says ghosted or joins its clean
-#                   models, `prune --model` with every model so far and one more mapper run,
+#                   check` on the last model, and where its report's `repair` is not empty
+#                   (a ghost's pairs to blame, or pairs that place a misplaced group or join
+#                   clean models), `prune --model` with every model so far and one more mapper run,
 #                   a row `repairedK` per turn [0]
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
@@ -102,7 +103,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
     "$work/check_$last.json" || break
   [ "$turn" -le "$REPAIR" ] || break
   models+=(--model "$work/sparse_$last")
-  log "the $last model is ghosted or in pieces: prune --model (turn $turn), mapper again"
+  log "the $last model is ghosted, misplaced or in pieces: prune --model (turn $turn), mapper again"
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
     --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args

@@ -67,8 +67,8 @@ python3 - "$work" "$runs" "$mappers" "$num_images" <<'PY'
 import json, os, sys
 work, runs, mappers, n = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
 rows = []
-verdict = lambda g: "ghosted" if g else "clean"
-print(f"{'run':>3} {'matching':<12} {'mapper':<10} {'first: correct':>14} {'check':>8} "
+verdict = lambda c: "ghosted" if c["ghosted"] else "misplaced" if c.get("misplaced") else "clean"
+print(f"{'run':>3} {'matching':<12} {'mapper':<10} {'first: correct':>14} {'check':>9} "
       f"{'turns':>5} {'after the loop: correct':>23} {'models':>6} {'check':>8}")
 for run in range(1, runs + 1):
     for matcher in ["colmap3.8", "pycolmap4.2"]:
@@ -79,15 +79,16 @@ for run in range(1, runs + 1):
                 e = json.load(open(f"{base}_{len(steps) + 1}.eval.json"))
                 c = json.load(open(f"{base}_{len(steps) + 1}.check.json"))
                 steps.append(dict(correct=e["correct"], registered=e["registered"],
-                                  models=e["models"], ghosted=c["ghosted"]))
+                                  models=e["models"], ghosted=c["ghosted"],
+                                  misplaced=c.get("misplaced", False)))
             if not steps:
                 continue
             rows.append(dict(run=run, matching=matcher, mapper=mapper, steps=steps))
             first, last = steps[0], steps[-1]
-            after = (f"{last['correct']:>20}/{n} {last['models']:>6} {verdict(last['ghosted']):>8}"
+            after = (f"{last['correct']:>20}/{n} {last['models']:>6} {verdict(last):>8}"
                      if len(steps) > 1 else f"{'(not needed)':>23} {'':>6} {'':>8}")
             print(f"{run:>3} {matcher:<12} {mapper:<10} {first['correct']:>11}/{n} "
-                  f"{verdict(first['ghosted']):>8} {len(steps) - 1:>5} {after}")
+                  f"{verdict(first):>9} {len(steps) - 1:>5} {after}")
 final = [r["steps"][-1]["correct"] for r in rows]
 print(f"after the loop: {n}/{n} correct in {sum(c == n for c in final)} of {len(final)} runs; "
       f"before it: {sum(r['steps'][0]['correct'] == n for r in rows)} of {len(rows)}")
