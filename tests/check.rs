@@ -56,6 +56,12 @@ fn check_exit_statuses_report_and_plots() {
     assert!(line.contains("clean"), "{line}");
     let value: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(value["ghosted"], false);
+    assert_eq!(value["misplaced"], false);
+    assert_eq!(value["models"][0]["misplaced"], Value::Null);
+    assert_eq!(
+        value["repair"],
+        serde_json::json!({ "blamed": [], "links": [] })
+    );
     assert_eq!(value["models"][0]["images"], 2);
     assert!(plots.join("top_view_0.svg").is_file());
     let missing = dir.path().join("nothing");
