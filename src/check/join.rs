@@ -165,20 +165,11 @@ pub fn misplaced(
         return Ok(None);
     };
     let placement = Similarity::from(&join.placement);
-    let mut moved: Vec<f64> = b
-        .points
-        .values()
-        .map(|p| {
-            let x = Vector3::new(p[0], p[1], p[2]);
-            (placement.apply(&x) - x).norm()
-        })
-        .collect();
-    if moved.is_empty() {
-        return Ok(None);
-    }
-    let mid = moved.len() / 2;
-    let median = *moved.select_nth_unstable_by(mid, f64::total_cmp).1;
-    Ok((median > MISPLACED_DISTANCE * spread(model)).then_some(join))
+    let moved = median(b.points.values().map(|p| {
+        let x = Vector3::new(p[0], p[1], p[2]);
+        (placement.apply(&x) - x).norm()
+    }));
+    Ok((moved > MISPLACED_DISTANCE * spread(model)).then_some(join))
 }
 
 /// `model`'s images named in `names`, with the points they observe.
@@ -343,9 +334,17 @@ fn spread(model: &SparseModel) -> f64 {
         return 0.0;
     }
     let centroid = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
-    let mut d: Vec<f64> = points.iter().map(|p| (p - centroid).norm()).collect();
-    let mid = d.len() / 2;
-    *d.select_nth_unstable_by(mid, f64::total_cmp).1
+    median(points.iter().map(|p| (p - centroid).norm()))
+}
+
+/// The median of `values` (the upper one of an even count; 0 for none).
+fn median(values: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = values.collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// The similarity (second model's frame -> first's) most of the `remaining` correspondences
