@@ -57,6 +57,8 @@ fn check_exit_statuses_report_and_plots() {
     let value: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(value["ghosted"], false);
     assert_eq!(value["misplaced"], false);
+    assert_eq!(value["unanchored"], false);
+    assert_eq!(value["models"][0]["unanchored"], serde_json::json!([]));
     assert_eq!(value["models"][0]["misplaced"], Value::Null);
     assert_eq!(
         value["repair"],

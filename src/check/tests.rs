@@ -227,6 +227,24 @@ fn an_image_alone_is_counted_as_the_general_split_counts_it() {
     }
 }
 
+/// An image registered without observing any 3D point makes the model wrong, named; the
+/// correct model has none.
+#[test]
+fn an_image_registered_without_a_point_is_unanchored() {
+    let mut model = correct_model();
+    assert!(check_model(&model, None, &DEFAULT_SETTINGS)
+        .unwrap()
+        .unanchored
+        .is_empty());
+    model.images[4]
+        .points2d
+        .iter_mut()
+        .for_each(|p| p.point3d_id = None);
+    let check = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
+    assert_eq!(check.unanchored, ["0005.png"]);
+    assert!(!check.ghosted && check.wrong());
+}
+
 #[test]
 fn the_check_is_deterministic() {
     let a = check_model(&ghosted_model(), None, &DEFAULT_SETTINGS).unwrap();

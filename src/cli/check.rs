@@ -1,5 +1,5 @@
 //! `check`: is a reconstruction ghosted, and where? One line per model, a JSON report, a top
-//! view per model, and an exit status a pipeline can branch on (3: ghosted or misplaced).
+//! view per model, and an exit status a pipeline can branch on (3: a model is wrong).
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -10,7 +10,8 @@ use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
 use vgsel_colmap::colmap::sparse::read_sparse_model;
 
-/// Exit status of a check that found a ghosted model, or one with a misplaced group.
+/// Exit status of a check that found a model wrong: ghosted, with a misplaced group, or with
+/// images registered without a 3D point.
 pub const EXIT_GHOSTED: u8 = 3;
 
 #[derive(Args)]
@@ -72,10 +73,11 @@ impl CheckArgs {
 /// The line a model gets: its verdict, score and groups; a clean model whose worst split had
 /// fewer judged samples than `min_conflicts` says so, as no ghost could have been found there.
 fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
-    let what = match (c.ghosted, &c.misplaced) {
-        (true, _) => "GHOSTED",
-        (false, Some(_)) => "MISPLACED",
-        (false, None) => "clean",
+    let what = match (c.ghosted, &c.misplaced, c.unanchored.is_empty()) {
+        (true, _, _) => "GHOSTED",
+        (false, Some(_), _) => "MISPLACED",
+        (false, None, false) => "UNANCHORED",
+        (false, None, true) => "clean",
     };
     let mut line = format!("{}: {what} (score {:.2}", dir.display(), c.score);
     if let Some(w) = &c.worst {
@@ -115,6 +117,18 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
             );
         }
     }
+    if !c.unanchored.is_empty() {
+        line += &format!(
+            "; {} images registered without a 3D point: {}",
+            c.unanchored.len(),
+            c.unanchored
+                .iter()
+                .take(3)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+    }
     line + ")"
 }
 
@@ -144,8 +158,8 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
     )
 }
 
-/// Runs the check; Ok(true) when some model is wrong (ghosted or misplaced). `quiet` silences
-/// the note on stderr.
+/// Runs the check; Ok(true) when some model is wrong (ghosted, misplaced or unanchored).
+/// `quiet` silences the note on stderr.
 pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     let settings = args.settings();
     let evidence = match &args.database_path {
@@ -178,10 +192,11 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
             let title = format!(
                 "{}: {} (score {:.2})",
                 dir.display(),
-                match (result.ghosted, result.misplaced.is_some()) {
-                    (true, _) => "ghosted",
-                    (false, true) => "misplaced",
-                    (false, false) => "clean",
+                match (result.ghosted, result.misplaced.is_some(), result.wrong()) {
+                    (true, _, _) => "ghosted",
+                    (false, true, _) => "misplaced",
+                    (false, false, true) => "unanchored",
+                    (false, false, false) => "clean",
                 },
                 result.score
             );
@@ -198,6 +213,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     }
     let ghosted = run.models.iter().any(|c| c.ghosted);
     let misplaced = run.models.iter().any(|c| c.misplaced.is_some());
+    let unanchored = run.models.iter().any(|c| !c.unanchored.is_empty());
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
     let mut joined = Vec::new();
@@ -216,6 +232,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         let report = serde_json::json!({
             "ghosted": ghosted,
             "misplaced": misplaced,
+            "unanchored": unanchored,
             "settings": settings,
             "models": reports,
             "joins": joined,
@@ -224,7 +241,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    Ok(ghosted || misplaced)
+    Ok(run.models.iter().any(ModelCheck::wrong))
 }
 
 #[cfg(test)]
@@ -252,6 +269,7 @@ mod tests {
                 joining_pairs: Vec::new(),
             }),
             misplaced: None,
+            unanchored: Vec::new(),
             side: Vec::new(),
             views: None,
         }
@@ -269,6 +287,22 @@ mod tests {
         );
         let line = verdict_line(Path::new("sparse/0"), &checked(2, 100), 30);
         assert!(!line.contains("too few"), "{line}");
+    }
+
+    /// Images registered without a 3D point make the verdict and are named.
+    #[test]
+    fn unanchored_images_are_named() {
+        let mut c = checked(2, 100);
+        c.unanchored = vec!["0019.png".into(), "0020.png".into()];
+        let line = verdict_line(Path::new("sparse/0"), &c, 30);
+        assert!(
+            line.starts_with("sparse/0: UNANCHORED (score 0.00"),
+            "{line}"
+        );
+        assert!(
+            line.ends_with("; 2 images registered without a 3D point: 0019.png 0020.png)"),
+            "{line}"
+        );
     }
 
     /// An image alone in its group is named on the verdict line.
