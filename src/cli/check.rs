@@ -70,14 +70,42 @@ impl CheckArgs {
     }
 }
 
+/// A model's verdict in a word: what is wrong with it first (ghosted, then misplaced, then
+/// unanchored), or clean.
+fn verdict(c: &ModelCheck) -> &'static str {
+    if c.ghosted {
+        "ghosted"
+    } else if c.misplaced.is_some() {
+        "misplaced"
+    } else if !c.unanchored.is_empty() {
+        "unanchored"
+    } else {
+        "clean"
+    }
+}
+
+/// Model `k`'s top view (`dir`'s, checked as `result`) into `plots` as `top_view_K.svg`.
+fn plot(plots: &Path, k: usize, dir: &Path, result: &ModelCheck) -> Result<()> {
+    let Some(views) = &result.views else {
+        return Ok(());
+    };
+    std::fs::create_dir_all(plots).with_context(|| format!("creating {}", plots.display()))?;
+    let title = format!(
+        "{}: {} (score {:.2})",
+        dir.display(),
+        verdict(result),
+        result.score
+    );
+    let path = plots.join(format!("top_view_{k}.svg"));
+    check::plot::top_view(views, &result.side, &title, &path)
+}
+
 /// The line a model gets: its verdict, score and groups; a clean model whose worst split had
 /// fewer judged samples than `min_conflicts` says so, as no ghost could have been found there.
 fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
-    let what = match (c.ghosted, &c.misplaced, c.unanchored.is_empty()) {
-        (true, _, _) => "GHOSTED",
-        (false, Some(_), _) => "MISPLACED",
-        (false, None, false) => "UNANCHORED",
-        (false, None, true) => "clean",
+    let what = match verdict(c) {
+        "clean" => "clean".to_string(),
+        wrong => wrong.to_uppercase(),
     };
     let mut line = format!("{}: {what} (score {:.2}", dir.display(), c.score);
     if let Some(w) = &c.worst {
@@ -186,26 +214,8 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
     let mut reports = Vec::new();
     for (k, (dir, result)) in dirs.iter().zip(&run.models).enumerate() {
         println!("{}", verdict_line(dir, result, settings.min_conflicts));
-        if let (Some(plots), Some(views)) = (&args.plots, &result.views) {
-            std::fs::create_dir_all(plots)
-                .with_context(|| format!("creating {}", plots.display()))?;
-            let title = format!(
-                "{}: {} (score {:.2})",
-                dir.display(),
-                match (result.ghosted, result.misplaced.is_some(), result.wrong()) {
-                    (true, _, _) => "ghosted",
-                    (false, true, _) => "misplaced",
-                    (false, false, true) => "unanchored",
-                    (false, false, false) => "clean",
-                },
-                result.score
-            );
-            check::plot::top_view(
-                views,
-                &result.side,
-                &title,
-                &plots.join(format!("top_view_{k}.svg")),
-            )?;
+        if let Some(plots) = &args.plots {
+            plot(plots, k, dir, result)?;
         }
         let mut value = serde_json::to_value(result)?;
         value["model"] = dir.display().to_string().into();
