@@ -75,8 +75,8 @@ pub struct ModelCheck<'e> {
     /// matches place elsewhere than the model does ([`join::misplaced`]). The model is wrong.
     pub misplaced: Option<join::Join>,
     /// Registered images that observe no 3D point of a model that has points (sorted): their
-    /// poses rest on nothing the model holds. None of the 216 correct models measured has one; 12 of 338
-    /// wrong ones do (docs/check.md).
+    /// poses rest on nothing the model holds. None of the 216 correct models measured has one;
+    /// 12 of 338 wrong ones do (docs/check.md).
     pub unanchored: Vec<String>,
     /// Which group each image is in (0 or 1) for the worst split, by image name.
     #[serde(skip)]
@@ -142,10 +142,14 @@ pub fn check_model<'e>(
     };
     let score = split.as_ref().map_or(0.0, |s| s.score);
     // A model without any point (a ground truth's poses) anchors nothing and claims nothing.
-    let mut unanchored: Vec<String> = (0..n)
-        .filter(|&v| !views.points.is_empty() && views.seen_by[v].is_empty())
-        .map(|v| views.views[v].name.clone())
-        .collect();
+    let mut unanchored: Vec<String> = if views.points.is_empty() {
+        Vec::new()
+    } else {
+        (0..n)
+            .filter(|&v| views.seen_by[v].is_empty())
+            .map(|v| views.views[v].name.clone())
+            .collect()
+    };
     unanchored.sort();
     let ghosted = split
         .as_ref()
@@ -311,8 +315,8 @@ pub struct ModelEvidence {
     pub links: Vec<[String; 2]>,
 }
 
-/// The check of a mapper's output: each model's, and the joins among its clean ones (only with
-/// the database's evidence).
+/// The check of a mapper's output: each model's (with its misplaced group, if any), and the
+/// joins among its clean ones (both only with the database's evidence).
 pub struct RunCheck<'e> {
     /// Each model's check, in the order given.
     pub models: Vec<ModelCheck<'e>>,
@@ -331,15 +335,13 @@ pub fn check_run<'e>(
         .iter()
         .map(|m| check_model(m, evidence, settings))
         .collect::<Result<Vec<_>>>()?;
-    if let Some(e) = evidence {
-        for (k, (model, c)) in models.iter().zip(&mut checks).enumerate() {
-            if let (false, Some(worst)) = (c.ghosted, &c.worst) {
-                c.misplaced = join::misplaced(k, model, &worst.groups, e, settings)?;
-            }
-        }
-    }
     let joins = match evidence {
         Some(e) => {
+            for (k, (model, c)) in models.iter().zip(&mut checks).enumerate() {
+                if let (false, Some(worst)) = (c.ghosted, &c.worst) {
+                    c.misplaced = join::misplaced(k, model, &worst.groups, e, settings)?;
+                }
+            }
             let checked: Vec<_> = models
                 .iter()
                 .zip(checks.iter().map(ModelCheck::wrong))
@@ -355,9 +357,9 @@ pub fn check_run<'e>(
 }
 
 impl RunCheck<'_> {
-    /// What `prune --model` takes from this run: the blamed pairs of its ghosted models and
-    /// the pairs linking the clean models it joins. Empty when a repair turn has nothing to act
-    /// on (the loop's scripts stop there).
+    /// What `prune --model` takes from this run: the blamed pairs of its ghosted models, and
+    /// the pairs linking the clean models it joins and the groups it found misplaced. Empty
+    /// when a repair turn has nothing to act on (the loop's scripts stop there).
     pub fn evidence(&self) -> ModelEvidence {
         let mut blamed = std::collections::BTreeSet::new();
         for checked in self.models.iter().filter(|c| c.ghosted) {

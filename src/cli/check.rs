@@ -9,6 +9,7 @@ use vgsel_colmap::check::{self, CheckSettings, ModelCheck, DEFAULT_SETTINGS};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
 use vgsel_colmap::colmap::sparse::read_sparse_model;
+use vgsel_colmap::geometry::similarity::Similarity;
 
 /// Exit status of a check that found a model wrong: ghosted, with a misplaced group, or with
 /// images registered without a 3D point.
@@ -123,13 +124,12 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
             line += "; too few samples to find a ghost";
         }
         if let Some(m) = &c.misplaced {
-            let r = &m.placement.rotation;
-            let angle = ((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0).clamp(-1.0, 1.0);
+            let placement = Similarity::from(&m.placement);
             line += &format!(
                 "; the database's matches place the second group {:.0}\u{b0} turned, scaled {:.2} \
                  (by {} of {} correspondences, after {} refuted); {} pairs link them, e.g. {}",
-                angle.acos().to_degrees(),
-                m.placement.scale,
+                placement.rotation.angle().to_degrees(),
+                placement.scale,
                 m.support,
                 m.correspondences,
                 m.refuted,
