@@ -91,7 +91,8 @@ map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds
 last=pruned models=()
 # Every model is checked, the last turn's too; a turn runs where the check gives `prune --model`
-# something to act on (its report's `repair`: pairs a ghost blames, pairs that join clean models).
+# something to act on (its report's `repair`: pairs a ghost blames, pairs that place a misplaced
+# group or join clean models).
 for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   [ "${REPAIR:-0}" -gt 0 ] || break
   status=0

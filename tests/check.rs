@@ -297,9 +297,7 @@ fn the_repair_loop_makes_one_correct_model_of_the_halls_two_orbits() {
             prune["overrides"]["model_conflicts"]
         );
         assert_eq!(check["repair"]["links"], prune["overrides"]["model_links"]);
-    }
-    // The preset alone folds the hall; one model of 38 takes the join of the two orbits.
-    if turns > 0 {
+        // The preset alone folds the hall; one model of 38 takes the join of the two orbits.
         assert!(
             checks.iter().any(|c| c.contains(": one scene (")),
             "{checks:?}"

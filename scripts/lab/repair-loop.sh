@@ -4,7 +4,8 @@
 # each run matches the rendered images (COLMAP 3.8 and pycolmap 4.2, as colmap4-mappers.sh),
 # prunes a copy (PRUNE_ARGS, default --preset disambiguation), maps it, runs `check` on the
 # model, and where check gives `prune --model` something to act on (its report's `repair`: a
-# ghost's blamed pairs, or pairs that join clean models) prunes again with --model and maps once more. Every model is scored against the ground truth.
+# ghost's blamed pairs, or pairs that place a misplaced group or join clean models) prunes again
+# with --model and maps once more. Every model is scored against the ground truth.
 # Prints one row per run and mapper; writes WORKDIR/loop.json.
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
 # most [3], each passing every earlier model to `prune --model`.
@@ -67,9 +68,9 @@ python3 - "$work" "$runs" "$mappers" "$num_images" <<'PY'
 import json, os, sys
 work, runs, mappers, n = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
 rows = []
-verdict = lambda c: "ghosted" if c["ghosted"] else "misplaced" if c.get("misplaced") else "clean"
-print(f"{'run':>3} {'matching':<12} {'mapper':<10} {'first: correct':>14} {'check':>9} "
-      f"{'turns':>5} {'after the loop: correct':>23} {'models':>6} {'check':>8}")
+verdict = lambda c: next((k for k in ("ghosted", "misplaced", "unanchored") if c.get(k)), "clean")
+print(f"{'run':>3} {'matching':<12} {'mapper':<10} {'first: correct':>14} {'check':>10} "
+      f"{'turns':>5} {'after the loop: correct':>23} {'models':>6} {'check':>10}")
 for run in range(1, runs + 1):
     for matcher in ["colmap3.8", "pycolmap4.2"]:
         for mapper in mappers:
@@ -80,15 +81,16 @@ for run in range(1, runs + 1):
                 c = json.load(open(f"{base}_{len(steps) + 1}.check.json"))
                 steps.append(dict(correct=e["correct"], registered=e["registered"],
                                   models=e["models"], ghosted=c["ghosted"],
-                                  misplaced=c.get("misplaced", False)))
+                                  misplaced=c.get("misplaced", False),
+                                  unanchored=c.get("unanchored", False)))
             if not steps:
                 continue
             rows.append(dict(run=run, matching=matcher, mapper=mapper, steps=steps))
             first, last = steps[0], steps[-1]
-            after = (f"{last['correct']:>20}/{n} {last['models']:>6} {verdict(last):>8}"
-                     if len(steps) > 1 else f"{'(not needed)':>23} {'':>6} {'':>8}")
+            after = (f"{last['correct']:>20}/{n} {last['models']:>6} {verdict(last):>10}"
+                     if len(steps) > 1 else f"{'(not needed)':>23} {'':>6} {'':>10}")
             print(f"{run:>3} {matcher:<12} {mapper:<10} {first['correct']:>11}/{n} "
-                  f"{verdict(first):>9} {len(steps) - 1:>5} {after}")
+                  f"{verdict(first):>10} {len(steps) - 1:>5} {after}")
 final = [r["steps"][-1]["correct"] for r in rows]
 print(f"after the loop: {n}/{n} correct in {sum(c == n for c in final)} of {len(final)} runs; "
       f"before it: {sum(r['steps'][0]['correct'] == n for r in rows)} of {len(rows)}")
