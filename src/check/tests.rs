@@ -204,6 +204,58 @@ fn an_image_registered_onto_the_other_copy_is_found_alone() {
     assert!(!check.ghosted, "score {}", check.score);
 }
 
+/// Matches between `a` and `b`, keypoint by keypoint, of the points `pair` maps each point of
+/// `a` to (its id in `b`), as a database holds them.
+fn matches_of(a: &SparseImage, b: &SparseImage, pair: impl Fn(u64) -> u64) -> Vec<[u32; 2]> {
+    let keypoint_of = |im: &SparseImage| -> BTreeMap<u64, u32> {
+        (im.points2d.iter().enumerate())
+            .map(|(k, p)| (p.point3d_id.unwrap(), k as u32))
+            .collect()
+    };
+    let (ka, kb) = (keypoint_of(a), keypoint_of(b));
+    ka.iter()
+        .filter_map(|(&id, &x)| kb.get(&pair(id)).map(|&y| [x, y]))
+        .collect()
+}
+
+/// The repair blames only the pairs that hold an image alone on the wrong copy: those whose
+/// matches the model keeps as one point (here the misplaced image's matches to images 1-4, on
+/// the shared object), not its true neighbours' (5-12), whose matches the model holds apart
+/// (its wall keypoints on the other copy's points). Two groups blame every pair sharing points.
+#[test]
+fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
+    let model = one_image_model(true);
+    let misplaced = &model.images[12];
+    let mut evidence = Evidence::default();
+    for (k, other) in model.images[..12].iter().enumerate() {
+        let m = if k < 4 {
+            matches_of(other, misplaced, |id| id)
+        } else {
+            // A first-wall point to the second wall's point of the same index.
+            matches_of(other, misplaced, |id| id + 10_000)
+        };
+        let key = (other.image.name.clone(), misplaced.image.name.clone());
+        evidence.pairs.insert(key.clone(), m.len());
+        evidence.matches.insert(key, m);
+    }
+    let run = check_run(std::slice::from_ref(&model), Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    assert!(run.models[0].ghosted, "score {}", run.models[0].score);
+    let blamed = run.evidence().blamed;
+    let expected: Vec<[String; 2]> = (1..=4)
+        .map(|k| [format!("{k:04}.png"), "0013.png".to_string()])
+        .collect();
+    assert_eq!(blamed, expected);
+    let worst = run.models[0].worst.as_ref().unwrap();
+    let apart = worst.joining_pairs.iter().filter(|p| p.matches_apart > p.matches_joined);
+    assert_eq!(apart.count(), 8);
+    // The same counts in a split of two groups blame every pair sharing points.
+    let held_apart = JoiningPair {
+        matches_apart: 10,
+        ..worst.joining_pairs[0].clone()
+    };
+    assert!(blames(&held_apart, false) && !blames(&held_apart, true));
+}
+
 /// The one-pass count of an image alone is the general count of that split, image by image, on
 /// models with and without a ghost, and with the database's matches.
 #[test]

@@ -100,6 +100,8 @@ pub struct View {
     /// Every keypoint's position, by keypoint index (the model's points2D order, which is the
     /// database's).
     pub keypoints: Vec<[f64; 2]>,
+    /// The point each keypoint observes, by keypoint index (None: not triangulated).
+    pub point_of: Vec<Option<usize>>,
 }
 
 /// The model as the check reads it, borrowing the database's matches from the [`Evidence`].
@@ -161,10 +163,12 @@ impl<'e> Views<'e> {
                 )
             })?;
             let mut grid = Grid::new();
+            let mut point_of = vec![None; im.points2d.len()];
             for (keypoint, p) in im.points2d.iter().enumerate() {
                 let Some(k) = p.point3d_id.and_then(|id| index.get(&id)) else {
                     continue;
                 };
+                point_of[keypoint] = Some(*k);
                 tracks[*k].push((v, keypoint as u32));
                 let key = (
                     (p.xy[0] / cell).floor() as i64,
@@ -181,6 +185,7 @@ impl<'e> Views<'e> {
                 intrinsics: Intrinsics::from_camera(camera),
                 grid,
                 keypoints: im.points2d.iter().map(|p| p.xy).collect(),
+                point_of,
             });
         }
         let mut seen_by = vec![Vec::new(); views.len()];
@@ -224,6 +229,29 @@ impl<'e> Views<'e> {
                 near(kb.get(y as usize), at, radius_b) && near(ka.get(x as usize), from, radius_a)
             })
         })
+    }
+
+    /// The verified matches of views `a` and `b` whose keypoints both observe points: how many
+    /// observe the same point, and how many two different ones (the model holds them apart).
+    pub fn matches_held(&self, a: usize, b: usize) -> (usize, usize) {
+        let Some(&(m, flipped)) = self.matches.get(&(a.min(b), a.max(b))) else {
+            return (0, 0);
+        };
+        let (pa, pb) = (&self.views[a].point_of, &self.views[b].point_of);
+        let swap = flipped != (a > b);
+        let (mut joined, mut apart) = (0, 0);
+        for &m in m {
+            let [x, y] = if swap { [m[1], m[0]] } else { m };
+            let at = |p: &[Option<usize>], k: u32| p.get(k as usize).copied().flatten();
+            if let (Some(p), Some(q)) = (at(pa, x), at(pb, y)) {
+                if p == q {
+                    joined += 1;
+                } else {
+                    apart += 1;
+                }
+            }
+        }
+        (joined, apart)
     }
 
     /// Neighbourhood radius in view `v`'s pixels for a radius given as a fraction of the
