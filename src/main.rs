@@ -70,7 +70,8 @@ enum Command {
   vgsel-colmap check --model sparse --database_path db.db --report check.json --plots plots
 
 Exit status: 0 every model clean (joinable models included), 3 some model ghosted, with a
-misplaced group or with images registered without a 3D point, 1 error, 2 bad command line.")]
+misplaced group or with images registered on (next to) no 3D point, 1 error, 2 bad command
+line.")]
     Check(cli::check::CheckArgs),
     /// Print the view graph's figures.
     Inspect(cli::inspect::InspectArgs),

@@ -13,7 +13,8 @@ Three kinds of work folder, as the lab scripts leave them:
 
 Prints one row per model folder (set, truth, exit status, verdict lines), then per set the
 counts of truth by verdict (exit status 0 clean, 3 wrong), and per sub-model the images
-registered without a 3D point (the report's `unanchored`) by truth.
+the check calls unanchored (the report's `unanchored`: on no 3D point, or next to none) by
+truth.
 
 usage: VGSEL=target/release/vgsel-colmap scripts/lab/recheck.py [--loops DIR ...]
        [--scenes DIR ...] [--peers WORK]
@@ -93,7 +94,7 @@ def main():
     print("\nset, truth, exit status (0 clean, 3 wrong): models")
     for key, n in sorted(verdicts.items()):
         print(*key, n)
-    print("\ntruth, some image registered without a 3D point: sub-models")
+    print("\ntruth, some image unanchored: sub-models")
     for key, n in sorted(unanchored.items()):
         print(*key, n)
 

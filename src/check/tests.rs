@@ -238,7 +238,12 @@ fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
         evidence.pairs.insert(key.clone(), m.len());
         evidence.matches.insert(key, m);
     }
-    let run = check_run(std::slice::from_ref(&model), Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let run = check_run(
+        std::slice::from_ref(&model),
+        Some(&evidence),
+        &DEFAULT_SETTINGS,
+    )
+    .unwrap();
     assert!(run.models[0].ghosted, "score {}", run.models[0].score);
     let blamed = run.evidence().blamed;
     let expected: Vec<[String; 2]> = (1..=4)
@@ -246,7 +251,10 @@ fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
         .collect();
     assert_eq!(blamed, expected);
     let worst = run.models[0].worst.as_ref().unwrap();
-    let apart = worst.joining_pairs.iter().filter(|p| p.matches_apart > p.matches_joined);
+    let apart = worst
+        .joining_pairs
+        .iter()
+        .filter(|p| p.matches_apart > p.matches_joined);
     assert_eq!(apart.count(), 8);
     // The same counts in a split of two groups blame every pair sharing points.
     let held_apart = JoiningPair {
@@ -295,6 +303,35 @@ fn an_image_registered_without_a_point_is_unanchored() {
     let check = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
     assert_eq!(check.unanchored, ["0005.png"]);
     assert!(!check.ghosted && check.wrong());
+}
+
+/// With the database, an image whose model keeps points for under 3% of its matched keypoints
+/// is unanchored too (here 1 in 100 of its keypoints); with 1 in 20 (5% or more of those
+/// matched) it is not.
+#[test]
+fn an_image_the_model_keeps_next_to_no_point_of_is_unanchored() {
+    let unanchored_keeping = |every: usize| {
+        let mut model = correct_model();
+        let mut evidence = Evidence::default();
+        for k in [3, 5] {
+            let m = matches_of(&model.images[4], &model.images[k], |id| id);
+            let key = (
+                model.images[4].image.name.clone(),
+                model.images[k].image.name.clone(),
+            );
+            evidence.matches.insert(key, m);
+        }
+        (model.images[4].points2d.iter_mut().enumerate())
+            .filter(|(k, _)| k % every != 0)
+            .for_each(|(_, p)| p.point3d_id = None);
+        let without = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
+        assert!(without.unanchored.is_empty(), "1 in {every}");
+        check_model(&model, Some(&evidence), &DEFAULT_SETTINGS)
+            .unwrap()
+            .unanchored
+    };
+    assert_eq!(unanchored_keeping(100), ["0005.png"]);
+    assert!(unanchored_keeping(20).is_empty());
 }
 
 #[test]

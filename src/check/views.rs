@@ -254,6 +254,27 @@ impl<'e> Views<'e> {
         (joined, apart)
     }
 
+    /// For each view, its keypoints with a verified match to another view of the model.
+    pub fn matched_keypoints(&self) -> Vec<usize> {
+        let mut matched: Vec<Vec<bool>> = (self.views.iter())
+            .map(|v| vec![false; v.keypoints.len()])
+            .collect();
+        for (&(a, b), &(m, flipped)) in &self.matches {
+            for &[x, y] in m {
+                let (ka, kb) = if flipped { (y, x) } else { (x, y) };
+                for (v, k) in [(a, ka), (b, kb)] {
+                    if let Some(slot) = matched[v].get_mut(k as usize) {
+                        *slot = true;
+                    }
+                }
+            }
+        }
+        matched
+            .iter()
+            .map(|m| m.iter().filter(|&&x| x).count())
+            .collect()
+    }
+
     /// Neighbourhood radius in view `v`'s pixels for a radius given as a fraction of the
     /// diagonal.
     pub fn radius(&self, v: usize, fraction: f64) -> f64 {

@@ -12,7 +12,7 @@ use vgsel_colmap::colmap::sparse::read_sparse_model;
 use vgsel_colmap::geometry::similarity::Similarity;
 
 /// Exit status of a check that found a model wrong: ghosted, with a misplaced group, or with
-/// images registered without a 3D point.
+/// images registered on (next to) no 3D point.
 pub const EXIT_GHOSTED: u8 = 3;
 
 #[derive(Args)]
@@ -146,9 +146,10 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         }
     }
     if !c.unanchored.is_empty() {
+        let n = c.unanchored.len();
         line += &format!(
-            "; {} images registered without a 3D point: {}",
-            c.unanchored.len(),
+            "; {n} image{} registered on (next to) no 3D point: {}",
+            if n == 1 { "" } else { "s" },
             c.unanchored
                 .iter()
                 .take(3)
@@ -299,7 +300,7 @@ mod tests {
         assert!(!line.contains("too few"), "{line}");
     }
 
-    /// Images registered without a 3D point make the verdict and are named.
+    /// Unanchored images make the verdict and are named.
     #[test]
     fn unanchored_images_are_named() {
         let mut c = checked(2, 100);
@@ -310,7 +311,7 @@ mod tests {
             "{line}"
         );
         assert!(
-            line.ends_with("; 2 images registered without a 3D point: 0019.png 0020.png)"),
+            line.ends_with("; 2 images registered on (next to) no 3D point: 0019.png 0020.png)"),
             "{line}"
         );
     }
