@@ -7,6 +7,7 @@
 //! [`super::evidence`]).
 
 use super::views::Views;
+use nalgebra::Vector3;
 use serde::Serialize;
 
 /// How the conflicts are counted.
@@ -67,21 +68,120 @@ fn membership(views: &Views, side: &[bool]) -> Vec<[bool; 2]> {
         .collect()
 }
 
+/// For each point, the views that could judge it: those that did not observe it but look at
+/// it as one of its observers did ([`judge`]'s angle and scale gates), in view order. A
+/// split's count visits these instead of every view: found once, they keep a model's check
+/// from growing with its images cubed (points times views, for each of some 2n splits).
+pub struct Reach {
+    /// By point: the views that could judge it.
+    views: Vec<Vec<usize>>,
+    /// By view: the points it observes or could judge, in point order.
+    points: Vec<Vec<usize>>,
+}
+
+impl Reach {
+    /// The views within the gates of each point of `views`.
+    pub fn new(views: &Views, settings: &ConflictSettings) -> Reach {
+        // Two cameras within the gates of a point stand at most `apart` times the first one's
+        // distance to it apart (the law of cosines at the largest angle and either scale).
+        let cos = settings.max_angle_deg.to_radians().cos();
+        let apart = [settings.max_scale, 1.0 / settings.max_scale]
+            .iter()
+            .map(|s| (1.0 + s * s - 2.0 * s * cos).max(0.0).sqrt())
+            .fold(0.0, f64::max)
+            * (1.0 + 1e-6);
+        let n = views.views.len();
+        let centre = |v: usize| views.views[v].centre;
+        // Each view's others by distance, as far as any point it saw allows.
+        let near: Vec<Vec<(f64, usize)>> = (0..n)
+            .map(|a| {
+                let farthest = (views.seen_by[a].iter())
+                    .map(|&k| (views.points[k] - centre(a)).norm())
+                    .fold(0.0, f64::max);
+                let mut near: Vec<(f64, usize)> = (0..n)
+                    .filter(|&b| b != a)
+                    .map(|b| ((centre(b) - centre(a)).norm(), b))
+                    .filter(|&(d, _)| d <= apart * farthest)
+                    .collect();
+                near.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+                near
+            })
+            .collect();
+        let mut taken = vec![usize::MAX; n];
+        let reach = (views.observers.iter().enumerate())
+            .map(|(k, track)| {
+                let x = views.points[k];
+                let mut out = Vec::new();
+                for &a in track {
+                    let limit = apart * (x - centre(a)).norm();
+                    for &(_, b) in near[a].iter().take_while(|(d, _)| *d <= limit) {
+                        if taken[b] != k
+                            && track.binary_search(&b).is_err()
+                            && within_gates(views, &x, a, b, settings)
+                        {
+                            taken[b] = k;
+                            out.push(b);
+                        }
+                    }
+                }
+                out.sort_unstable();
+                out
+            })
+            .collect::<Vec<Vec<usize>>>();
+        let mut points = vec![Vec::new(); n];
+        for (k, (track, judging)) in views.observers.iter().zip(&reach).enumerate() {
+            track.iter().chain(judging).for_each(|&v| points[v].push(k));
+        }
+        Reach {
+            views: reach,
+            points,
+        }
+    }
+
+    /// The views that could judge point `k`, in view order.
+    pub fn of(&self, k: usize) -> &[usize] {
+        &self.views[k]
+    }
+}
+
+/// Whether view `b` looks at point `x` as view `a` does: from nearly its direction and its
+/// distance.
+pub(super) fn within_gates(
+    views: &Views,
+    x: &Vector3<f64>,
+    a: usize,
+    b: usize,
+    settings: &ConflictSettings,
+) -> bool {
+    let to_b = x - views.views[b].centre;
+    let to_a = x - views.views[a].centre;
+    let scale = to_b.norm() / to_a.norm();
+    to_b.normalize().dot(&to_a.normalize()) >= settings.max_angle_deg.to_radians().cos()
+        && scale <= settings.max_scale
+        && scale * settings.max_scale >= 1.0
+}
+
 /// The conflicts of the split `side` (true: group B) in both directions.
-pub fn count(views: &Views, side: &[bool], settings: &ConflictSettings) -> Counts {
+pub fn count(views: &Views, reach: &Reach, side: &[bool], settings: &ConflictSettings) -> Counts {
     let member = membership(views, side);
     let mut counts = Counts::default();
-    for (k, track) in views.observers.iter().enumerate() {
-        for b in 0..views.views.len() {
+    // A point counts only where it reaches both groups (observed in one, observed or judged
+    // in the other): every such point is among those the smaller group reaches.
+    let smaller = usize::from(side.iter().filter(|&&s| s).count() * 2 <= side.len());
+    let mut visited = vec![false; views.points.len()];
+    let reached = (0..side.len())
+        .filter(|&v| usize::from(side[v]) == smaller)
+        .flat_map(|v| &reach.points[v]);
+    for &k in reached {
+        if std::mem::replace(&mut visited[k], true) {
+            continue;
+        }
+        let track = &views.observers[k];
+        // Only points the other group saw.
+        let other = |b: usize| member[k][1 - usize::from(side[b])];
+        counts.seen += track.iter().filter(|&&b| other(b)).count();
+        for &b in reach.of(k).iter().filter(|&&b| other(b)) {
             let group = usize::from(side[b]);
-            // Only points the other group saw.
-            if !member[k][1 - group] {
-                continue;
-            }
-            if track.binary_search(&b).is_ok() {
-                counts.seen += 1;
-                continue;
-            }
             let from: Vec<(usize, u32)> = track
                 .iter()
                 .copied()
@@ -96,11 +196,12 @@ pub fn count(views: &Views, side: &[bool], settings: &ConflictSettings) -> Count
 }
 
 /// [`count`] of the split that puts view `b` alone in one group, in one pass over the points
-/// instead of one per view: what `b` saw, judged in every other view; what the others saw and
+/// `b` saw or could judge: what `b` saw, judged in every other view; what the others saw and
 /// `b` did not, judged in `b`.
-pub fn count_alone(views: &Views, b: usize, settings: &ConflictSettings) -> Counts {
+pub fn count_alone(views: &Views, reach: &Reach, b: usize, settings: &ConflictSettings) -> Counts {
     let mut counts = Counts::default();
-    for (k, track) in views.observers.iter().enumerate() {
+    for &k in &reach.points[b] {
+        let track = &views.observers[k];
         match track.binary_search(&b) {
             Ok(at) => {
                 if track.len() > 1 {
@@ -109,7 +210,7 @@ pub fn count_alone(views: &Views, b: usize, settings: &ConflictSettings) -> Coun
                 }
                 let from = [(b, views.observed_at[k][at])];
                 let ours = |j: usize| views.observers[j].binary_search(&b).is_ok();
-                for v in (0..views.views.len()).filter(|v| track.binary_search(v).is_err()) {
+                for &v in reach.of(k) {
                     counts.add(judge(views, k, v, &from, &ours, settings));
                 }
             }
@@ -163,18 +264,10 @@ fn judge(
     settings: &ConflictSettings,
 ) -> Option<Sample> {
     let x = views.points[k];
-    let view = &views.views[b];
-    let to_b = x - view.centre;
-    let (ray_b, distance_b) = (to_b.normalize(), to_b.norm());
-    let cos_max = settings.max_angle_deg.to_radians().cos();
-    let close = from.iter().any(|&(a, _)| {
-        let to_a = x - views.views[a].centre;
-        let scale = distance_b / to_a.norm();
-        ray_b.dot(&to_a.normalize()) >= cos_max
-            && scale <= settings.max_scale
-            && scale * settings.max_scale >= 1.0
-    });
-    if !close {
+    if !from
+        .iter()
+        .any(|&(a, _)| within_gates(views, &x, a, b, settings))
+    {
         return None;
     }
     let at = views.project(b, k)?;

@@ -224,7 +224,8 @@ fn join_two(
             let (merged, side) = put_together(a, b, &placement);
             let views = Views::new(&merged, settings.conflict.radius, Some(evidence))?;
             let side: Vec<bool> = views.views.iter().map(|v| side.contains(&v.name)).collect();
-            let counts = conflict::count(&views, &side, &settings.conflict);
+            let reach = conflict::Reach::new(&views, &settings.conflict);
+            let counts = conflict::count(&views, &reach, &side, &settings.conflict);
             let score = score(&counts, settings);
             // The check's own verdict on the two models put together.
             if score >= settings.threshold && counts.conflicting >= settings.min_conflicts {

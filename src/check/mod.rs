@@ -21,10 +21,11 @@ use crate::colmap::sparse::SparseModel;
 use anyhow::Result;
 use conflict::Counts;
 use evidence::Evidence;
+use rayon::prelude::*;
 use serde::Serialize;
 use settings::score;
 pub use settings::{CheckSettings, DEFAULT_SETTINGS};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use views::Views;
 
 /// A database pair (verified, not invalidated by a prune) between the two groups.
@@ -80,7 +81,8 @@ pub struct ModelCheck<'e> {
     /// matches place elsewhere than the model does ([`join::misplaced`]). The model is wrong.
     pub misplaced: Option<join::Join>,
     /// Registered images of a model that has points whose poses rest on (next to) nothing it
-    /// holds ([`unanchored`]), sorted.
+    /// holds: no point, or points for under [`ANCHORED_FRACTION`] of their matched keypoints;
+    /// sorted.
     pub unanchored: Vec<String>,
     /// Which group each image is in (0 or 1) for the worst split, by image name.
     #[serde(skip)]
@@ -110,27 +112,33 @@ pub fn check_model<'e>(
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
     let groups = candidates(&views, &covisibility, settings);
-    let scored = groups.iter().map(|side| {
-        (
-            side.clone(),
-            conflict::count(&views, side, &settings.conflict),
-        )
-    });
-    let mut worst = worst_split(scored, settings);
+    let reach = conflict::Reach::new(&views, &settings.conflict);
+    let scored: Vec<(Vec<bool>, Counts)> = groups
+        .par_iter()
+        .map(|side| {
+            let counts = conflict::count(&views, &reach, side, &settings.conflict);
+            (side.clone(), counts)
+        })
+        .collect();
+    let mut worst = worst_split(scored.into_iter(), settings);
     let mut splits_scored = groups.len();
     // An image registered alone onto the other copy (a street's camera one building off) is no
     // split of groups; where no such split is ghosted, each image alone is scored too.
     if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
+        let known: HashSet<&Vec<bool>> = groups.iter().collect();
         let singles: Vec<(usize, Vec<bool>)> = (0..n)
             .map(|v| (v, splits::normalised((0..n).map(|w| w == v).collect())))
-            .filter(|(_, side)| !groups.contains(side))
+            .filter(|(_, side)| !known.contains(side))
             .collect();
         splits_scored += singles.len();
-        let scored = singles.into_iter().map(|(v, side)| {
-            let counts = conflict::count_alone(&views, v, &settings.conflict);
-            (side, counts)
-        });
-        if let Some(single) = worst_split(scored, settings) {
+        let scored: Vec<(Vec<bool>, Counts)> = singles
+            .into_par_iter()
+            .map(|(v, side)| {
+                let counts = conflict::count_alone(&views, &reach, v, &settings.conflict);
+                (side, counts)
+            })
+            .collect();
+        if let Some(single) = worst_split(scored.into_iter(), settings) {
             if is_ghost(&single.1, settings) {
                 worst = Some(single);
             }
@@ -232,7 +240,7 @@ fn candidates(
         .map(|&(a, b)| (covisibility.strength(a, b), a, b))
         .collect();
     let pairs: Vec<Counts> = links
-        .iter()
+        .par_iter()
         .map(|&(_, a, b)| conflict::pair_counts(views, a, b, &settings.conflict))
         .collect();
     let consistent: Vec<(f64, usize, usize)> = links
@@ -252,12 +260,18 @@ fn candidates(
     let min = settings.min_group;
     let spectral = splits::spectral_splits(n, &agreeing, min);
     let components = splits::component_splits(n, &agreeing, min);
-    let mut out = splits::candidate_splits(n, &splits::spanning_tree(n, links), min);
+    let first = splits::candidate_splits(n, &splits::spanning_tree(n, links), min);
     let tree = splits::candidate_splits(n, &splits::spanning_tree(n, consistent), min);
-    for side in tree.into_iter().chain(spectral).chain(components) {
-        splits::push_split(&mut out, side);
+    let mut out = splits::SplitList::default();
+    for side in first
+        .into_iter()
+        .chain(tree)
+        .chain(spectral)
+        .chain(components)
+    {
+        out.push(side);
     }
-    out
+    out.into_vec()
 }
 
 fn describe(

@@ -6,7 +6,7 @@
 //! are where such groups meet (Heinly et al., ECCV 2014, split along a spanning tree too).
 
 use super::views::Views;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 
 /// Shared 3D points per image pair (smaller view index first), and points per view.
 #[derive(Clone, Debug)]
@@ -75,7 +75,7 @@ pub fn spanning_tree(n: usize, mut edges: Vec<(f64, usize, usize)>) -> Vec<(usiz
 /// marks the side cut off (the one without view 0). In a forest, the other trees stay with
 /// view 0's side.
 pub fn candidate_splits(n: usize, tree: &[(usize, usize)], min_group: usize) -> Vec<Vec<bool>> {
-    let mut out: Vec<Vec<bool>> = Vec::new();
+    let mut out = SplitList::default();
     for cut in 0..tree.len() {
         let mut adjacent = vec![Vec::new(); n];
         for (k, &(a, b)) in tree.iter().enumerate() {
@@ -98,10 +98,10 @@ pub fn candidate_splits(n: usize, tree: &[(usize, usize)], min_group: usize) -> 
         }
         let b = side.iter().filter(|s| **s).count();
         if b >= min_group && n - b >= min_group {
-            push_split(&mut out, side);
+            out.push(side);
         }
     }
-    out
+    out.into_vec()
 }
 
 /// The one form every split is kept in: the model's first image in the `false` group, so that a
@@ -113,11 +113,26 @@ pub fn normalised(mut side: Vec<bool>) -> Vec<bool> {
     side
 }
 
-/// Adds `side` to `out`, [`normalised`], unless it is there already.
-pub fn push_split(out: &mut Vec<Vec<bool>>, side: Vec<bool>) {
-    let side = normalised(side);
-    if !out.contains(&side) {
-        out.push(side);
+/// Splits in the order found, each once, [`normalised`] (a set beside the list: a model of n
+/// images offers some 4n candidates).
+#[derive(Default)]
+pub struct SplitList {
+    list: Vec<Vec<bool>>,
+    seen: HashSet<Vec<bool>>,
+}
+
+impl SplitList {
+    /// Adds `side` unless it is there already.
+    pub fn push(&mut self, side: Vec<bool>) {
+        let side = normalised(side);
+        if self.seen.insert(side.clone()) {
+            self.list.push(side);
+        }
+    }
+
+    /// The splits, in the order found.
+    pub fn into_vec(self) -> Vec<Vec<bool>> {
+        self.list
     }
 }
 
@@ -153,13 +168,13 @@ pub fn spectral_splits(
     let y: Vec<f64> = (0..n).map(|i| fiedler[i] / d[i].sqrt()).collect();
     let mut by_value: Vec<usize> = (0..n).collect();
     by_value.sort_by(|&a, &b| y[a].total_cmp(&y[b]).then(a.cmp(&b)));
-    let mut out = Vec::new();
+    let mut out = SplitList::default();
     for k in min_group..=n - min_group {
         let mut side = vec![false; n];
         by_value[k..].iter().for_each(|&v| side[v] = true);
-        push_split(&mut out, side);
+        out.push(side);
     }
-    out
+    out.into_vec()
 }
 
 /// Each connected component of the graph of `edges` with at least `min_group` views, and at
@@ -177,13 +192,13 @@ pub fn component_splits(
         }
     }
     let roots: Vec<usize> = (0..n).map(|v| sets.find(v)).collect();
-    let mut out = Vec::new();
+    let mut out = SplitList::default();
     for root in 0..n {
         let side: Vec<bool> = roots.iter().map(|&r| r == root).collect();
         let size = side.iter().filter(|s| **s).count();
         if size >= min_group && n - size >= min_group {
-            push_split(&mut out, side);
+            out.push(side);
         }
     }
-    out
+    out.into_vec()
 }

@@ -276,13 +276,47 @@ fn an_image_alone_is_counted_as_the_general_split_counts_it() {
     ];
     for (model, evidence) in &cases {
         let views = Views::new(model, DEFAULT_SETTINGS.conflict.radius, *evidence).unwrap();
+        let reach = conflict::Reach::new(&views, &DEFAULT_SETTINGS.conflict);
         let n = views.views.len();
         for v in 0..n {
             let side: Vec<bool> = (0..n).map(|w| w == v).collect();
-            let general = conflict::count(&views, &side, &DEFAULT_SETTINGS.conflict);
-            let alone = conflict::count_alone(&views, v, &DEFAULT_SETTINGS.conflict);
+            let general = conflict::count(&views, &reach, &side, &DEFAULT_SETTINGS.conflict);
+            let alone = conflict::count_alone(&views, &reach, v, &DEFAULT_SETTINGS.conflict);
             assert_eq!(alone, general, "image {v}");
             assert!(general.conflicting + general.agreeing > 0, "image {v}");
+        }
+    }
+}
+
+/// The views a split's count visits for each point are exactly those within the gates of
+/// one of its observers that did not observe it (brute force over every view), on models with
+/// cameras at several depths and with gates wider than the defaults.
+#[test]
+fn the_views_that_can_judge_a_point_are_found_by_distance_as_by_brute_force() {
+    let mut wide = DEFAULT_SETTINGS.conflict;
+    wide.max_angle_deg = 70.0;
+    wide.max_scale = 2.5;
+    for settings in [DEFAULT_SETTINGS.conflict, wide] {
+        for model in [
+            ghosted_model_at(5.0),
+            one_image_model(true),
+            correct_model(),
+        ] {
+            let views = Views::new(&model, settings.radius, None).unwrap();
+            let reach = conflict::Reach::new(&views, &settings);
+            let mut visited = 0;
+            for (k, track) in views.observers.iter().enumerate() {
+                let x = views.points[k];
+                let brute: Vec<usize> = (0..views.views.len())
+                    .filter(|b| track.binary_search(b).is_err())
+                    .filter(|&b| {
+                        (track.iter()).any(|&a| conflict::within_gates(&views, &x, a, b, &settings))
+                    })
+                    .collect();
+                assert_eq!(reach.of(k), brute, "point {k}");
+                visited += brute.len();
+            }
+            assert!(visited > 0);
         }
     }
 }
