@@ -69,9 +69,9 @@ fn membership(views: &Views, side: &[bool]) -> Vec<[bool; 2]> {
 }
 
 /// For each point, the views that could judge it: those that did not observe it but look at
-/// it as one of its observers did (the angle and scale gates of [`ConflictSettings`]), in view order. A
-/// split's count visits these instead of every view: found once, they keep a model's check
-/// from growing with its images cubed (points times views, for each of some 2n splits).
+/// it as one of its observers did (the angle and scale gates of [`ConflictSettings`]), in view
+/// order. A split's count visits these instead of every view: found once, they keep a model's
+/// check from growing with its images cubed (points times views, for each of some 4n splits).
 pub struct Reach {
     /// By point: the views that could judge it.
     views: Vec<Vec<usize>>,
