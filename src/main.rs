@@ -132,7 +132,7 @@ fn main() -> ExitCode {
         Command::Prune(args) => cli::prune::run(&args, quiet, &progress),
         Command::Restore(args) => cli::restore::run(&args, quiet),
         Command::Inspect(args) => cli::inspect::run(&args),
-        Command::Check(args) => cli::check::run(&args, quiet).map(|g| ghosted = g),
+        Command::Check(args) => cli::check::run(&args, quiet, &progress).map(|g| ghosted = g),
         Command::Solve(args) => cli::solve::run(&args),
         #[cfg(feature = "eval")]
         Command::Eval(args) => cli::eval::run(&args),

@@ -1,6 +1,7 @@
 //! `check`: is a reconstruction ghosted, and where? One line per model, a JSON report, a top
 //! view per model, and an exit status a pipeline can branch on (3: a model is wrong).
 
+use crate::cli::progress::Progress;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -188,11 +189,15 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
 }
 
 /// Runs the check; Ok(true) when some model is wrong (ghosted, misplaced or unanchored).
-/// `quiet` silences the note on stderr.
-pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
+/// `quiet` silences the note on stderr; `progress` shows the stages (a large model's check
+/// takes minutes).
+pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
     let settings = args.settings();
     let evidence = match &args.database_path {
-        Some(path) => Some(Evidence::load(&Database::open_read_only(path)?)?),
+        Some(path) => {
+            progress.stage("reading the database's matches");
+            Some(Evidence::load(&Database::open_read_only(path)?)?)
+        }
         None => None,
     };
     if evidence.is_none() && !quiet {
@@ -207,11 +212,16 @@ pub fn run(args: &CheckArgs, quiet: bool) -> Result<bool> {
         "no COLMAP model in {}",
         args.model.display()
     );
+    let plural = if dirs.len() == 1 { "" } else { "s" };
+    progress.stage(&format!("reading {} model{plural}", dirs.len()));
     let models = dirs
         .iter()
         .map(|dir| read_sparse_model(dir))
         .collect::<Result<Vec<_>>>()?;
+    let images: usize = models.iter().map(|m| m.images.len()).sum();
+    progress.stage(&format!("checking {images} registered images"));
     let run = check::check_run(&models, evidence.as_ref(), &settings)?;
+    progress.finish();
     let mut reports = Vec::new();
     for (k, (dir, result)) in dirs.iter().zip(&run.models).enumerate() {
         println!("{}", verdict_line(dir, result, settings.min_conflicts));
