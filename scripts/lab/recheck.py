@@ -5,7 +5,10 @@ wrong copy", "A misplaced group", "Unanchored images").
 
 Three kinds of work folder, as the lab scripts leave them:
   --loops DIR ...   scripts/lab/repair-loop.sh's: MODEL.eval.json beside each turn's model, the
-                    database MAPPER.db beside it; truth: every registered camera correct
+                    database MAPPER.db beside it; truth: every registered camera correct. That
+                    database holds the last turn's selection: verdicts do not depend on which
+                    pairs are valid (every match counts, pruned or not), the reports' joining
+                    pairs of earlier turns do
   --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned, global_full,
                     global_pruned per scene with their databases; truth: SUB.eval.json's, per
                     sub-model, "unknown" without ground truth
