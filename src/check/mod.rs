@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use settings::score;
 pub use settings::{CheckSettings, DEFAULT_SETTINGS};
-use std::collections::{BTreeMap, HashSet};
+use std::collections::BTreeMap;
 use views::Views;
 
 /// A database pair (verified, not invalidated by a prune) between the two groups.
@@ -111,7 +111,8 @@ pub fn check_model<'e>(
     let pairs = evidence.map(|e| &e.pairs);
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
-    let groups = candidates(&views, &covisibility, settings);
+    let candidates = candidates(&views, &covisibility, settings);
+    let groups = candidates.as_slice();
     let reach = conflict::Reach::new(&views, &settings.conflict);
     let scored: Vec<(Vec<bool>, Counts)> = groups
         .par_iter()
@@ -125,10 +126,9 @@ pub fn check_model<'e>(
     // An image registered alone onto the other copy (a street's camera one building off) is no
     // split of groups; where no such split is ghosted, each image alone is scored too.
     if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
-        let known: HashSet<&Vec<bool>> = groups.iter().collect();
         let singles: Vec<(usize, Vec<bool>)> = (0..n)
             .map(|v| (v, splits::normalised((0..n).map(|w| w == v).collect())))
-            .filter(|(_, side)| !known.contains(side))
+            .filter(|(_, side)| !candidates.contains(side))
             .collect();
         splits_scored += singles.len();
         let scored: Vec<(Vec<bool>, Counts)> = singles
@@ -232,7 +232,7 @@ fn candidates(
     views: &Views,
     covisibility: &splits::Covisibility,
     settings: &CheckSettings,
-) -> Vec<Vec<bool>> {
+) -> splits::SplitList {
     let n = views.views.len();
     let links: Vec<(f64, usize, usize)> = covisibility
         .shared
@@ -271,7 +271,7 @@ fn candidates(
     {
         out.push(side);
     }
-    out.into_vec()
+    out
 }
 
 fn describe(

@@ -134,6 +134,16 @@ impl SplitList {
     pub fn into_vec(self) -> Vec<Vec<bool>> {
         self.list
     }
+
+    /// The splits, in the order found, kept.
+    pub fn as_slice(&self) -> &[Vec<bool>] {
+        &self.list
+    }
+
+    /// Whether `side` (normalised) is one of them.
+    pub fn contains(&self, side: &[bool]) -> bool {
+        self.seen.contains(side)
+    }
 }
 
 /// The sweep cuts of the graph's spectral embedding: images ordered by the Fiedler vector of

@@ -220,28 +220,26 @@ impl<'e> Views<'e> {
             xy.is_some_and(|xy| (xy[0] - to[0]).hypot(xy[1] - to[1]) <= r)
         };
         let (ka, kb) = (&self.views[a].keypoints, &self.views[b].keypoints);
-        let key = (a.min(b), a.max(b));
-        self.matches.get(&key).is_some_and(|&(m, flipped)| {
-            // Each match as (keypoint of a, keypoint of b).
-            let swap = flipped != (a > b);
-            m.iter().any(|&m| {
-                let [x, y] = if swap { [m[1], m[0]] } else { m };
-                near(kb.get(y as usize), at, radius_b) && near(ka.get(x as usize), from, radius_a)
-            })
+        self.pair_matches(a, b).any(|[x, y]| {
+            near(kb.get(y as usize), at, radius_b) && near(ka.get(x as usize), from, radius_a)
         })
+    }
+
+    /// The verified matches of views `a` and `b`, each as (keypoint of a, keypoint of b); none
+    /// without a database.
+    fn pair_matches(&self, a: usize, b: usize) -> impl Iterator<Item = [u32; 2]> + '_ {
+        let found = self.matches.get(&(a.min(b), a.max(b)));
+        let (m, flipped) = found.map_or((&[][..], false), |&(m, f)| (m, f));
+        let swap = flipped != (a > b);
+        m.iter().map(move |&m| if swap { [m[1], m[0]] } else { m })
     }
 
     /// The verified matches of views `a` and `b` whose keypoints both observe points: how many
     /// observe the same point, and how many two different ones (the model holds them apart).
     pub fn matches_held(&self, a: usize, b: usize) -> (usize, usize) {
-        let Some(&(m, flipped)) = self.matches.get(&(a.min(b), a.max(b))) else {
-            return (0, 0);
-        };
         let (pa, pb) = (&self.views[a].point_of, &self.views[b].point_of);
-        let swap = flipped != (a > b);
         let (mut joined, mut apart) = (0, 0);
-        for &m in m {
-            let [x, y] = if swap { [m[1], m[0]] } else { m };
+        for [x, y] in self.pair_matches(a, b) {
             let at = |p: &[Option<usize>], k: u32| p.get(k as usize).copied().flatten();
             if let (Some(p), Some(q)) = (at(pa, x), at(pb, y)) {
                 if p == q {
