@@ -67,10 +67,18 @@ fn wall(n: usize) -> SparseModel {
     }
 }
 
+/// The model sizes: 50, 100 and 200 images, or those `CHECK_BENCH_IMAGES` lists (`800,1600`).
+fn sizes() -> Vec<usize> {
+    match std::env::var("CHECK_BENCH_IMAGES") {
+        Ok(list) => list.split(',').map(|n| n.trim().parse().unwrap()).collect(),
+        Err(_) => vec![50, 100, 200],
+    }
+}
+
 fn bench_check(c: &mut Criterion) {
     let mut group = c.benchmark_group("check, a correct model of n images");
     group.sample_size(10);
-    for n in [50, 100, 200] {
+    for n in sizes() {
         let model = wall(n);
         group.bench_with_input(BenchmarkId::from_parameter(n), &model, |b, model| {
             b.iter(|| check_model(model, None, &DEFAULT_SETTINGS).unwrap())
