@@ -60,6 +60,7 @@ fn check_exit_statuses_report_and_plots() {
     assert_eq!(value["unanchored"], false);
     assert_eq!(value["models"][0]["unanchored"], serde_json::json!([]));
     assert_eq!(value["models"][0]["misplaced"], Value::Null);
+    assert_eq!(value["models"][0]["ghost_placement"], Value::Null);
     assert_eq!(
         value["repair"],
         serde_json::json!({ "blamed": [], "links": [] })

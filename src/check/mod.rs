@@ -80,6 +80,10 @@ pub struct ModelCheck<'e> {
     /// With the database: the worst split of a clean model whose second group the database's
     /// matches place elsewhere than the model does ([`join::misplaced`]). The model is wrong.
     pub misplaced: Option<join::Join>,
+    /// With the database, for a ghosted model: where its matches place the worst split's
+    /// second group once the model's own placement is refuted ([`join::ghost_placement`]);
+    /// its links are the true pairs across the ghost, which the repair keeps.
+    pub ghost_placement: Option<join::Join>,
     /// Registered images of a model that has points whose poses rest on (next to) nothing it
     /// holds: no point, or points for under [`ANCHORED_FRACTION`] of their matched keypoints;
     /// sorted.
@@ -164,6 +168,7 @@ pub fn check_model<'e>(
         score,
         worst: split,
         misplaced: None,
+        ghost_placement: None,
         unanchored: unanchored(&views),
         side,
         views: Some(views),
@@ -375,7 +380,11 @@ pub fn check_run<'e>(
     let joins = match evidence {
         Some(e) => {
             for (k, (model, c)) in models.iter().zip(&mut checks).enumerate() {
-                if let (false, Some(worst)) = (c.ghosted, &c.worst) {
+                let Some(worst) = &c.worst else { continue };
+                if c.ghosted {
+                    c.ghost_placement =
+                        join::ghost_placement(k, model, &worst.groups, e, settings)?;
+                } else {
                     c.misplaced = join::misplaced(k, model, &worst.groups, e, settings)?;
                 }
             }
@@ -395,7 +404,8 @@ pub fn check_run<'e>(
 
 impl RunCheck<'_> {
     /// What `prune --model` takes from this run: the blamed pairs of its ghosted models, and
-    /// the pairs linking the clean models it joins and the groups it found misplaced. Empty
+    /// the pairs linking the clean models it joins, the groups it found misplaced and the
+    /// ghosts' second groups where the matches place them (kept over the blame). Empty
     /// when a repair turn has nothing to act on (the loop's scripts stop there).
     pub fn evidence(&self) -> ModelEvidence {
         let mut blamed = std::collections::BTreeSet::new();
@@ -411,8 +421,11 @@ impl RunCheck<'_> {
             }
         }
         let mut links = std::collections::BTreeSet::new();
-        let misplaced = self.models.iter().filter_map(|c| c.misplaced.as_ref());
-        for l in self.joins.iter().chain(misplaced).flat_map(|j| &j.links) {
+        let placed = self
+            .models
+            .iter()
+            .flat_map(|c| c.misplaced.iter().chain(&c.ghost_placement));
+        for l in self.joins.iter().chain(placed).flat_map(|j| &j.links) {
             let (a, b) = (l.image1.clone(), l.image2.clone());
             links.insert(if a < b { [a, b] } else { [b, a] });
         }

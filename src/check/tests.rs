@@ -727,3 +727,45 @@ fn a_group_the_database_places_elsewhere_is_misplaced() {
         }
     }
 }
+
+/// The hall-like two models as one ghost: the second wall's cameras carried onto the first
+/// object by the placement the false matches give. The check calls it ghosted; the database's
+/// matches place the second group back by the true pairs, which the repair keeps, over the
+/// blame of every pair across the split that shares points.
+#[test]
+fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
+    let (a, b, evidence) = hall_like();
+    // The first object is 5 units left of the second.
+    let fold = Similarity {
+        scale: back_from_elsewhere().scale,
+        rotation: back_from_elsewhere().rotation,
+        translation: back_from_elsewhere().translation - Vector3::new(5.0, 0.0, 0.0),
+    };
+    let one = join::put_together(&a, &b, &fold).0;
+    let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let c = &run.models[0];
+    assert!(c.ghosted, "score {}", c.score);
+    assert!(c.misplaced.is_none());
+    let g = c
+        .ghost_placement
+        .as_ref()
+        .expect("the true pairs place the group back");
+    // The model's own placement counts as refuted, and the false matches' (the same) again.
+    assert_eq!(g.refuted, 2);
+    let second = &c.worst.as_ref().unwrap().groups[1];
+    let of_b = b.images.iter().any(|im| im.image.name == second[0]);
+    let moved_right = if of_b { 5.0 } else { -5.0 };
+    let p = Similarity::from(&g.placement);
+    assert!((p.scale - 1.0).abs() < 1e-6, "{p:?}");
+    assert!(p.rotation.angle() < 1e-6, "{p:?}");
+    let shift = p.translation - Vector3::new(moved_right, 0.0, 0.0);
+    assert!(shift.norm() < 1e-6, "{p:?}");
+    assert!(!g.links.is_empty());
+    for l in &g.links {
+        let [ia, ib] = [&l.image1, &l.image2].map(|n| n[..4].parse::<u32>().unwrap());
+        assert!(ia.abs_diff(ib) != 6, "a twin pair links: {l:?}");
+    }
+    // The fixture's copies share no 3D point, so nothing is blamed; the links are kept.
+    let evidence = run.evidence();
+    assert_eq!(evidence.links.len(), g.links.len());
+}

@@ -125,18 +125,7 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
             line += "; too few samples to find a ghost";
         }
         if let Some(m) = &c.misplaced {
-            let placement = Similarity::from(&m.placement);
-            line += &format!(
-                "; the database's matches place the second group {:.0}\u{b0} turned, scaled {:.2} \
-                 (by {} of {} correspondences, after {} refuted); {} pairs link them, e.g. {}",
-                placement.rotation.angle().to_degrees(),
-                placement.scale,
-                m.support,
-                m.correspondences,
-                m.refuted,
-                m.links.len(),
-                examples(m.links.iter().map(|l| (&l.image1, &l.image2)))
-            );
+            line += &placement_text(m);
         }
         if c.ghosted {
             line += &format!(
@@ -144,6 +133,9 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
                 w.joining_pairs.len(),
                 examples(w.joining_pairs.iter().map(|p| (&p.image1, &p.image2)))
             );
+        }
+        if let Some(m) = &c.ghost_placement {
+            line += &placement_text(m);
         }
     }
     if !c.unanchored.is_empty() {
@@ -160,6 +152,22 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         );
     }
     line + ")"
+}
+
+/// Where the database's matches place a model's second group, and the pairs that link it.
+fn placement_text(m: &check::join::Join) -> String {
+    let placement = Similarity::from(&m.placement);
+    format!(
+        "; the database's matches place the second group {:.0}\u{b0} turned, scaled {:.2} (by \
+         {} of {} correspondences, after {} refuted); {} pairs link them, e.g. {}",
+        placement.rotation.angle().to_degrees(),
+        placement.scale,
+        m.support,
+        m.correspondences,
+        m.refuted,
+        m.links.len(),
+        examples(m.links.iter().map(|l| (&l.image1, &l.image2)))
+    )
 }
 
 /// The first three `pairs` as `a-b c-d e-f`.
@@ -290,6 +298,7 @@ mod tests {
                 joining_pairs: Vec::new(),
             }),
             misplaced: None,
+            ghost_placement: None,
             unanchored: Vec::new(),
             side: Vec::new(),
             views: None,
