@@ -64,14 +64,14 @@ enum Command {
     /// Put back every pair a prune invalidated, byte for byte, and drop vgsel-colmap's tables.
     Restore(cli::args::DatabaseArg),
     /// Is a reconstruction ghosted (copies of repeated structure registered onto each other)?
-    /// With the database, also whether its matches place a group of a model elsewhere than the
-    /// model does, and which clean models of one run they place in one frame.
+    /// With the database, also whether its matches place a group or an image of a model
+    /// elsewhere than the model does, and which clean models of one run they place in one frame.
     #[command(after_help = "Examples:
   vgsel-colmap check --model sparse --database_path db.db --report check.json --plots plots
 
 Exit status: 0 every model clean (joinable models included), 3 some model ghosted, with a
-misplaced group or with images registered on (next to) no 3D point, 1 error, 2 bad command
-line.")]
+misplaced group or image or with images registered on (next to) no 3D point, 1 error, 2 bad
+command line.")]
     Check(cli::check::CheckArgs),
     /// Print the view graph's figures.
     Inspect(cli::inspect::InspectArgs),

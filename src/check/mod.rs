@@ -6,13 +6,16 @@
 //! image alone against the rest is a candidate too; each split is scored by
 //! conflicting observations ([`conflict`]); a model whose worst split's score (its conflict
 //! ratio, with a prior of agreeing samples) reaches the threshold is ghosted, and the report
-//! names the two groups and the database pairs that join them. docs/check.md gives the method,
+//! names the two groups and the database pairs that join them. With the database, a clean
+//! model's worst split and each of its images are also placed where the matches put them
+//! ([`join`], [`resection`]). docs/check.md gives the method,
 //! what it assumes and its measurements.
 
 pub mod conflict;
 pub mod evidence;
 pub mod join;
 pub mod plot;
+pub mod resection;
 pub mod settings;
 pub mod splits;
 pub mod views;
@@ -84,6 +87,9 @@ pub struct ModelCheck<'e> {
     /// second group once the model's own placement is refuted ([`join::ghost_placement`]);
     /// its links are the true pairs across the ghost, which the repair keeps.
     pub ghost_placement: Option<join::Join>,
+    /// With the database, for a model the conflicts call clean: images its matches place
+    /// elsewhere ([`resection`]). The model is wrong.
+    pub misplaced_images: Vec<resection::MisplacedImage>,
     /// Registered images of a model that has points whose poses rest on (next to) nothing it
     /// holds: no point, or points for under [`ANCHORED_FRACTION`] of their matched keypoints;
     /// sorted.
@@ -100,7 +106,10 @@ impl ModelCheck<'_> {
     /// Ghosted, a group of it misplaced, or images in it unanchored: the model is wrong where
     /// the check can tell.
     pub fn wrong(&self) -> bool {
-        self.ghosted || self.misplaced.is_some() || !self.unanchored.is_empty()
+        self.ghosted
+            || self.misplaced.is_some()
+            || !self.misplaced_images.is_empty()
+            || !self.unanchored.is_empty()
     }
 }
 
@@ -169,6 +178,7 @@ pub fn check_model<'e>(
         worst: split,
         misplaced: None,
         ghost_placement: None,
+        misplaced_images: Vec::new(),
         unanchored: unanchored(&views),
         side,
         views: Some(views),
@@ -386,6 +396,9 @@ pub fn check_run<'e>(
                         join::ghost_placement(k, model, &worst.groups, e, settings)?;
                 } else {
                     c.misplaced = join::misplaced(k, model, &worst.groups, e, settings)?;
+                    if let Some(views) = &c.views {
+                        c.misplaced_images = resection::misplaced_images(views)?;
+                    }
                 }
             }
             let checked: Vec<_> = models
@@ -420,7 +433,14 @@ impl RunCheck<'_> {
                 blamed.insert([p.image1.clone(), p.image2.clone()]);
             }
         }
+        let images = self.models.iter().flat_map(|c| &c.misplaced_images);
+        for pair in images.clone().flat_map(|m| &m.against) {
+            blamed.insert(pair.clone());
+        }
         let mut links = std::collections::BTreeSet::new();
+        for [a, b] in images.flat_map(|m| &m.links).cloned() {
+            links.insert(if a < b { [a, b] } else { [b, a] });
+        }
         let placed = self
             .models
             .iter()

@@ -769,3 +769,46 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
     let evidence = run.evidence();
     assert_eq!(evidence.links.len(), g.links.len());
 }
+
+/// An image the model holds one unit to the side of where its keypoints see the wall: its
+/// matches to its neighbours' points place it back, by the pairs that then link it; held in
+/// place, nothing is misplaced.
+#[test]
+fn an_image_its_matches_place_elsewhere_is_misplaced() {
+    let with_shift = |shift: f64| {
+        let mut model = correct_model();
+        let mut evidence = Evidence::default();
+        for k in [2, 3, 5, 6] {
+            let m = matches_of(&model.images[4], &model.images[k], |id| id);
+            let key = (
+                model.images[4].image.name.clone(),
+                model.images[k].image.name.clone(),
+            );
+            evidence.matches.insert(key, m);
+        }
+        model.images[4].image.translation.x -= shift;
+        (model, evidence)
+    };
+    let (model, evidence) = with_shift(0.0);
+    let in_place = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    assert!(in_place.models[0].misplaced_images.is_empty());
+    assert!(!in_place.models[0].wrong());
+    let (model, evidence) = with_shift(1.0);
+    let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let c = &run.models[0];
+    assert!(!c.ghosted, "score {}", c.score);
+    assert!(c.wrong());
+    let [m] = &c.misplaced_images[..] else {
+        panic!("{:?}", c.misplaced_images)
+    };
+    assert_eq!(m.image, "0005.png");
+    // The wall's points lie about 2 units from their centroid: 1 unit is about half of that.
+    assert!(m.moved > 0.3 && m.moved < 0.7, "{m:?}");
+    assert!(m.support >= m.correspondences * 9 / 10, "{m:?}");
+    assert_eq!(m.model_support, 0, "{m:?}");
+    assert_eq!(m.links.len(), 4);
+    assert!(m.against.is_empty());
+    let evidence = run.evidence();
+    assert_eq!(evidence.links.len(), 4);
+    assert!(evidence.blamed.is_empty());
+}

@@ -56,6 +56,20 @@ impl Intrinsics {
         }
     }
 
+    /// The pinhole part as OpenCV's camera matrix.
+    pub fn camera_matrix(&self) -> [[f64; 3]; 3] {
+        [
+            [self.f[0], 0.0, self.c[0]],
+            [0.0, self.f[1], self.c[1]],
+            [0.0, 0.0, 1.0],
+        ]
+    }
+
+    /// The distortion as OpenCV's coefficients (k1, k2, p1, p2).
+    pub fn distortion(&self) -> [f64; 4] {
+        [self.k[0], self.k[1], self.p[0], self.p[1]]
+    }
+
     /// Pixel position of a point in camera coordinates, if in front and inside the image.
     pub fn project(&self, x: &Vector3<f64>) -> Option<[f64; 2]> {
         if x.z <= 1e-9 {
@@ -227,7 +241,7 @@ impl<'e> Views<'e> {
 
     /// The verified matches of views `a` and `b`, each as (keypoint of a, keypoint of b); none
     /// without a database.
-    fn pair_matches(&self, a: usize, b: usize) -> impl Iterator<Item = [u32; 2]> + '_ {
+    pub(super) fn pair_matches(&self, a: usize, b: usize) -> impl Iterator<Item = [u32; 2]> + '_ {
         let found = self.matches.get(&(a.min(b), a.max(b)));
         let (m, flipped) = found.map_or((&[][..], false), |&(m, f)| (m, f));
         let swap = flipped != (a > b);

@@ -77,7 +77,7 @@ impl CheckArgs {
 fn verdict(c: &ModelCheck) -> &'static str {
     if c.ghosted {
         "ghosted"
-    } else if c.misplaced.is_some() {
+    } else if c.misplaced.is_some() || !c.misplaced_images.is_empty() {
         "misplaced"
     } else if !c.unanchored.is_empty() {
         "unanchored"
@@ -137,6 +137,20 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         if let Some(m) = &c.ghost_placement {
             line += &placement_text(m);
         }
+    }
+    for m in &c.misplaced_images {
+        line += &format!(
+            "; the database's matches place {} {:.0}% of the model's spread away ({} of {} \
+             correspondences agree, {} with the model's pose); {} pairs place it back, {} \
+             against it",
+            m.image,
+            100.0 * m.moved,
+            m.support,
+            m.correspondences,
+            m.model_support,
+            m.links.len(),
+            m.against.len()
+        );
     }
     if !c.unanchored.is_empty() {
         let n = c.unanchored.len();
@@ -241,7 +255,8 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
         reports.push(value);
     }
     let ghosted = run.models.iter().any(|c| c.ghosted);
-    let misplaced = run.models.iter().any(|c| c.misplaced.is_some());
+    let misplaced =
+        (run.models.iter()).any(|c| c.misplaced.is_some() || !c.misplaced_images.is_empty());
     let unanchored = run.models.iter().any(|c| !c.unanchored.is_empty());
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
@@ -299,6 +314,7 @@ mod tests {
             }),
             misplaced: None,
             ghost_placement: None,
+            misplaced_images: Vec::new(),
             unanchored: Vec::new(),
             side: Vec::new(),
             views: None,
