@@ -812,3 +812,79 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     assert_eq!(evidence.links.len(), 4);
     assert!(evidence.blamed.is_empty());
 }
+
+/// A ghost the matches cannot place while they place one of its images elsewhere is that
+/// image's: the repair keeps and blames that image's pairs, not every pair across the split;
+/// with its group placed, or no image placed, the split's pairs that share points are blamed.
+#[test]
+fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_image() {
+    let pair = |a: &str, b: &str, shared: usize| JoiningPair {
+        image1: a.into(),
+        image2: b.into(),
+        inliers: 100,
+        shared_points: shared,
+        matches_joined: 0,
+        matches_apart: 0,
+    };
+    let image = resection::MisplacedImage {
+        image: "c.png".into(),
+        correspondences: 100,
+        model_support: 10,
+        support: 90,
+        moved: 0.3,
+        links: vec![["c.png".into(), "b.png".into()]],
+        against: vec![["c.png".into(), "d.png".into()]],
+    };
+    let ghost = |images: Vec<resection::MisplacedImage>, placed: bool| ModelCheck {
+        images: 4,
+        points: 10,
+        splits_scored: 1,
+        ghosted: true,
+        score: 0.5,
+        worst: Some(Split {
+            groups: [
+                vec!["a.png".into(), "b.png".into()],
+                vec!["c.png".into(), "d.png".into()],
+            ],
+            counts: Counts::default(),
+            ratio: 0.5,
+            score: 0.5,
+            joining_pairs: vec![pair("a.png", "c.png", 3), pair("b.png", "d.png", 0)],
+        }),
+        misplaced: None,
+        ghost_placement: placed.then(|| join::Join {
+            models: [0, 0],
+            correspondences: 0,
+            placement: join::Placement {
+                scale: 1.0,
+                rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                translation: [1.0, 0.0, 0.0],
+            },
+            support: 0,
+            refuted: 1,
+            counts: Counts::default(),
+            score: 0.0,
+            links: Vec::new(),
+        }),
+        misplaced_images: images,
+        unanchored: Vec::new(),
+        side: Vec::new(),
+        views: None,
+    };
+    let evidence = |c: ModelCheck<'static>| {
+        RunCheck {
+            models: vec![c],
+            joins: Vec::new(),
+        }
+        .evidence()
+    };
+    let named = |a: &str, b: &str| [a.to_string(), b.to_string()];
+    let as_image = evidence(ghost(vec![image.clone()], false));
+    assert_eq!(as_image.blamed, [named("c.png", "d.png")]);
+    assert_eq!(as_image.links, [named("b.png", "c.png")]);
+    let as_groups = evidence(ghost(Vec::new(), false));
+    assert_eq!(as_groups.blamed, [named("a.png", "c.png")]);
+    assert!(as_groups.links.is_empty());
+    let placed = evidence(ghost(vec![image], true));
+    assert!(placed.blamed.contains(&named("a.png", "c.png")));
+}
