@@ -5,7 +5,7 @@
 //! matches of another copy (the demo's image 0000 with the global mapper: 13-22% of the
 //! scene off, its two false pairs among three selected) sits where neither agrees; its true
 //! matches, pruned or not, place it back. The pairs that agree with that pose are the links
-//! `prune --model` keeps; the selected pairs that do not are blamed.
+//! `prune --model` keeps; those that agree with the model's pose instead are blamed.
 
 use super::join::MISPLACED_DISTANCE;
 use super::views::Views;
@@ -50,12 +50,13 @@ pub struct MisplacedImage {
     /// How far the matches' pose moves the camera centre, over the model's spread (the median
     /// distance of its points to their centroid).
     pub moved: f64,
-    /// The pairs (this image, another) with at least [`PAIR_MIN_CORRESPONDENCES`] correspondences, at
-    /// least half of them agreeing with the matches' pose: they place it back (`prune --model`
-    /// keeps them).
+    /// The pairs (this image, another) with at least [`PAIR_MIN_CORRESPONDENCES`]
+    /// correspondences, at least half of them agreeing with the matches' pose: they place it
+    /// back (`prune --model` keeps them).
     pub links: Vec<[String; 2]>,
-    /// The pairs with as many correspondences, under half of them agreeing with the matches'
-    /// pose: they pulled it away (`prune --model` blames them).
+    /// The pairs with as many correspondences, at least half of them agreeing with the
+    /// model's pose and more than with the matches': they hold it where the model put it
+    /// (`prune --model` blames them).
     pub against: Vec<[String; 2]>,
 }
 
@@ -117,20 +118,20 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<MisplacedImage>>
             .project(&(r * views.points[*p] + t))
             .is_some_and(|q| (q[0] - xy[0]).hypot(q[1] - xy[1]) <= AGREE_PX)
     };
-    // Per other view: correspondences, and those agreeing with the matches' pose.
-    let mut pairs: Vec<(usize, usize, usize)> = Vec::new();
+    // Per other view: correspondences, those agreeing with the model's pose and those
+    // agreeing with the matches'.
+    let mut pairs: Vec<(usize, [usize; 3])> = Vec::new();
     let (mut model_support, mut support) = (0, 0);
     for k in &c {
-        let s = agrees(&rotation, &translation, k);
-        model_support += usize::from(agrees(&view.rotation, &view.translation, k));
-        support += usize::from(s);
+        let m = usize::from(agrees(&view.rotation, &view.translation, k));
+        let s = usize::from(agrees(&rotation, &translation, k));
+        (model_support, support) = (model_support + m, support + s);
         match pairs.last_mut() {
             _ if k.2 == v => {}
             Some(last) if last.0 == k.2 => {
-                last.1 += 1;
-                last.2 += usize::from(s);
+                last.1 = [last.1[0] + 1, last.1[1] + m, last.1[2] + s];
             }
-            _ => pairs.push((k.2, 1, usize::from(s))),
+            _ => pairs.push((k.2, [1, m, s])),
         }
     }
     let moved = (-(rotation.transpose() * translation) - view.centre).norm() / spread;
@@ -141,21 +142,22 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<MisplacedImage>>
         return Ok(None);
     }
     let named = |w: usize| [view.name.clone(), views.views[w].name.clone()];
-    let judged = pairs.iter().filter(|p| p.1 >= PAIR_MIN_CORRESPONDENCES);
+    let judged = pairs.iter().filter(|p| p.1[0] >= PAIR_MIN_CORRESPONDENCES);
+    let list = |keep: &dyn Fn(&[usize; 3]) -> bool| -> Vec<[String; 2]> {
+        judged
+            .clone()
+            .filter(|p| keep(&p.1))
+            .map(|p| named(p.0))
+            .collect()
+    };
     Ok(Some(MisplacedImage {
         image: view.name.clone(),
         correspondences: c.len(),
         model_support,
         support,
         moved,
-        links: (judged.clone())
-            .filter(|p| 2 * p.2 >= p.1)
-            .map(|p| named(p.0))
-            .collect(),
-        against: judged
-            .filter(|p| 2 * p.2 < p.1)
-            .map(|p| named(p.0))
-            .collect(),
+        links: list(&|[n, _, s]| 2 * s >= *n),
+        against: list(&|[n, m, s]| 2 * m >= *n && m > s),
     }))
 }
 

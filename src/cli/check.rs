@@ -139,12 +139,16 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         }
     }
     for m in &c.misplaced_images {
+        // A pose far outside the model (RANSAC on few distant points) is no distance worth
+        // printing.
+        let distance = match m.moved {
+            d if d > 10.0 => "over 10 times the model's spread".to_string(),
+            d => format!("{:.0}% of the model's spread", 100.0 * d),
+        };
         line += &format!(
-            "; the database's matches place {} {:.0}% of the model's spread away ({} of {} \
-             correspondences agree, {} with the model's pose); {} pairs place it back, {} \
-             against it",
+            "; the database's matches place {} {distance} away ({} of {} correspondences \
+             agree, {} with the model's pose); {} pairs place it back, {} against it",
             m.image,
-            100.0 * m.moved,
             m.support,
             m.correspondences,
             m.model_support,
