@@ -772,7 +772,7 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
 
 /// An image the model holds one unit to the side of where its keypoints see the wall: its
 /// matches to its neighbours' points place it back, by the pairs that then link it; held in
-/// place, nothing is misplaced.
+/// place, or five units off, nothing is misplaced.
 #[test]
 fn an_image_its_matches_place_elsewhere_is_misplaced() {
     let with_shift = |shift: f64| {
@@ -811,6 +811,10 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     let evidence = run.evidence();
     assert_eq!(evidence.links.len(), 4);
     assert!(evidence.blamed.is_empty());
+    // Five units off (over twice the spread) is a jump, not a correction: not called so.
+    let (model, evidence) = with_shift(5.0);
+    let far = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    assert!(far.models[0].misplaced_images.is_empty());
 }
 
 /// A ghost the matches cannot place while they place one of its images elsewhere is that
