@@ -149,51 +149,32 @@ pub fn join_models(
     Ok(joins)
 }
 
-/// Model `k`'s two `groups` (its worst split) placed as two models are: where the database's
-/// matches put the second group elsewhere than the model does (by the placement [`join_models`]
-/// would join them with, moving its points by more than [`MISPLACED_DISTANCE`] of the model's
-/// spread), the model misplaced it as a whole. A global mapper with few true links left
+/// Model `k`'s two `groups` (its worst split) placed as two models are, by the placement
+/// [`join_models`] would join them with, where it moves the second group's points by more than
+/// [`MISPLACED_DISTANCE`] of the model's spread.
+///
+/// For a clean model (`ghosted` false) that placement must come after a refuted one, as a
+/// join's: the model misplaced the group as a whole. A global mapper with few true links left
 /// between two copies can do this: the hall's second orbit, turned 17 degrees (docs/check.md).
-pub fn misplaced(
+///
+/// For a ghosted model the model's own placement is the ghost, refuted by the check already,
+/// so the first placement without conflict is taken: its links are the true pairs across the
+/// ghost, which `prune --model` keeps while it blames the pairs that glued the copies.
+/// Measured on 18 ghosted models of the demo, hall and street designs: 328 of 329 links true,
+/// where the blamed pairs held 303 true of 1,724 (docs/check.md).
+pub fn place_group(
     k: usize,
     model: &SparseModel,
     groups: &[Vec<String>; 2],
     evidence: &Evidence,
     settings: &CheckSettings,
-) -> anyhow::Result<Option<Join>> {
-    place_group(k, model, groups, evidence, settings, 0)
-}
-
-/// A ghosted model `k`'s second group (of its worst split's `groups`) placed by the database's
-/// matches: the model's own placement is the ghost, refuted by the check already, so the first
-/// placement without conflict that moves the group is taken, and its links are the true pairs
-/// across the ghost, which `prune --model` keeps while it blames the pairs that glued the
-/// copies. Measured on 18 ghosted models of the demo, hall and street designs: 328 of 329 links
-/// true, where the blamed pairs held 303 true of 1,724 (docs/check.md).
-pub fn ghost_placement(
-    k: usize,
-    model: &SparseModel,
-    groups: &[Vec<String>; 2],
-    evidence: &Evidence,
-    settings: &CheckSettings,
-) -> anyhow::Result<Option<Join>> {
-    place_group(k, model, groups, evidence, settings, 1)
-}
-
-/// The second of model `k`'s `groups` placed in the first's frame after `refuted` placements
-/// (see [`join_two`]), where that moves its points by more than [`MISPLACED_DISTANCE`].
-fn place_group(
-    k: usize,
-    model: &SparseModel,
-    groups: &[Vec<String>; 2],
-    evidence: &Evidence,
-    settings: &CheckSettings,
-    refuted: usize,
+    ghosted: bool,
 ) -> anyhow::Result<Option<Join>> {
     if groups.iter().any(|g| g.len() < settings.min_group) {
         return Ok(None);
     }
     let [a, b] = [&groups[0], &groups[1]].map(|g| subset(model, g));
+    let refuted = usize::from(ghosted);
     let Some(join) = join_two([k, k], [&a, &b], evidence, settings, refuted)? else {
         return Ok(None);
     };

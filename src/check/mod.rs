@@ -81,10 +81,10 @@ pub struct ModelCheck<'e> {
     /// The worst split, if the model could be split at all.
     pub worst: Option<Split>,
     /// With the database: the worst split of a clean model whose second group the database's
-    /// matches place elsewhere than the model does ([`join::misplaced`]). The model is wrong.
+    /// matches place elsewhere than the model does ([`join::place_group`]). The model is wrong.
     pub misplaced: Option<join::Join>,
     /// With the database, for a ghosted model: where its matches place the worst split's
-    /// second group once the model's own placement is refuted ([`join::ghost_placement`]);
+    /// second group once the model's own placement is refuted ([`join::place_group`]);
     /// its links are the true pairs across the ghost, which the repair keeps.
     pub ghost_placement: Option<join::Join>,
     /// With the database, for a model the conflicts call clean, or ghosted by a split whose
@@ -364,7 +364,7 @@ pub struct ModelEvidence {
     pub blamed: Vec<[String; 2]>,
     /// The pairs that link clean models the database's matches place in one frame without a
     /// conflict ([`join`]), and the two groups of a model that misplaced one of them
-    /// ([`join::misplaced`]): what the mapper needs to place them right. Sorted.
+    /// ([`join::place_group`]): what the mapper needs to place them right. Sorted.
     pub links: Vec<[String; 2]>,
 }
 
@@ -378,7 +378,7 @@ pub struct RunCheck<'e> {
 }
 
 /// Checks every model of one mapper run and, with `evidence`, places the two groups of each
-/// clean one ([`join::misplaced`]) and joins the models still clean.
+/// clean one ([`join::place_group`]) and joins the models still clean.
 pub fn check_run<'e>(
     models: &[SparseModel],
     evidence: Option<&'e Evidence>,
@@ -394,13 +394,13 @@ pub fn check_run<'e>(
                 let Some(worst) = &c.worst else { continue };
                 if c.ghosted {
                     c.ghost_placement =
-                        join::ghost_placement(k, model, &worst.groups, e, settings)?;
+                        join::place_group(k, model, &worst.groups, e, settings, true)?;
                     // A split the matches cannot place may be one image off, not two groups.
                     if let (None, Some(views)) = (&c.ghost_placement, &c.views) {
                         c.misplaced_images = resection::misplaced_images(views)?;
                     }
                 } else {
-                    c.misplaced = join::misplaced(k, model, &worst.groups, e, settings)?;
+                    c.misplaced = join::place_group(k, model, &worst.groups, e, settings, false)?;
                     if let Some(views) = &c.views {
                         c.misplaced_images = resection::misplaced_images(views)?;
                     }
