@@ -431,8 +431,10 @@ impl RunCheck<'_> {
         // place elsewhere, is that image's: blaming every pair across its split would tear
         // the model (street seed 19: one camera a building off, a split of 16 against 28
         // images at 0.51; its 323 pairs blamed, the next run registered 28 of 44).
+        // An image alone keeps its own blame.
         let group_ghost = |c: &&ModelCheck| {
-            c.ghosted && (c.ghost_placement.is_some() || c.misplaced_images.is_empty())
+            let alone = (c.worst.iter()).any(|w| w.groups.iter().any(|g| g.len() == 1));
+            c.ghosted && (alone || c.ghost_placement.is_some() || c.misplaced_images.is_empty())
         };
         for worst in self
             .models

@@ -817,9 +817,10 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     assert!(far.models[0].misplaced_images.is_empty());
 }
 
-/// A ghost the matches cannot place while they place one of its images elsewhere is that
-/// image's: the repair keeps and blames that image's pairs, not every pair across the split;
-/// with its group placed, or no image placed, the split's pairs that share points are blamed.
+/// A ghost of groups the matches cannot place while they place one of its images elsewhere is
+/// that image's: the repair keeps and blames that image's pairs, not every pair across the
+/// split; with its group placed, or no image placed, the split's pairs that share points are
+/// blamed; an image alone keeps its own blame.
 #[test]
 fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_image() {
     let pair = |a: &str, b: &str, shared: usize| JoiningPair {
@@ -889,6 +890,23 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
     let as_groups = evidence(ghost(Vec::new(), false));
     assert_eq!(as_groups.blamed, [named("a.png", "c.png")]);
     assert!(as_groups.links.is_empty());
-    let placed = evidence(ghost(vec![image], true));
+    let placed = evidence(ghost(vec![image.clone()], true));
     assert!(placed.blamed.contains(&named("a.png", "c.png")));
+    // An image alone keeps its blame (pairs whose matches the model joins), the misplaced
+    // image's evidence beside it.
+    let mut alone = ghost(vec![image], false);
+    let worst = alone.worst.as_mut().unwrap();
+    worst.groups = [
+        vec!["a.png".into(), "b.png".into(), "d.png".into()],
+        vec!["c.png".into()],
+    ];
+    worst.joining_pairs = vec![JoiningPair {
+        matches_joined: 5,
+        ..pair("a.png", "c.png", 3)
+    }];
+    let alone = evidence(alone);
+    assert_eq!(
+        alone.blamed,
+        [named("a.png", "c.png"), named("c.png", "d.png")]
+    );
 }
