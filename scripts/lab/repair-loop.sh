@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The repair loop on the demo scene with COLMAP 4.2's mappers (MAPPERS: global, incremental) or
 # COLMAP 3.8's (colmap3.8), over several fresh matchings:
-# each run matches the rendered images (COLMAP 3.8 and pycolmap 4.2, as colmap4-mappers.sh),
+# each run matches the rendered images (COLMAP 3.8 and pycolmap 4.2, as colmap4-mappers.sh; COLMAP
+# 3.8 alone where MAPPERS is colmap3.8),
 # prunes a copy (PRUNE_ARGS, default --preset disambiguation), maps it, runs `check` on the
 # model, and where check gives `prune --model` something to act on (its report's `repair`: a
 # ghost's blamed pairs, or pairs that place a misplaced group or join clean models) prunes again
@@ -34,6 +35,8 @@ score() { # MODEL DB -> correct/registered/models as JSON
 }
 for run in $(seq 1 "$runs"); do
   for matcher in colmap3.8 pycolmap4.2; do
+    # COLMAP 3.8 alone maps no pycolmap matching (it cannot read 4.2's schema): skip it.
+    [ "$mappers/$matcher" = colmap3.8/pycolmap4.2 ] && continue
     dir=$work/$run/$matcher
     mkdir -p "$dir"
     echo "run $run: $matcher matching" >&2
