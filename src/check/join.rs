@@ -74,7 +74,7 @@ pub struct Link {
 #[derive(Clone, Debug, Serialize)]
 pub struct Join {
     /// The two models, as indices of the checked folders (a model's own index twice for its
-    /// [`misplaced`] group).
+    /// group placed by [`place_group`]).
     pub models: [usize; 2],
     /// Correspondences between the two models.
     pub correspondences: usize,
