@@ -1,5 +1,6 @@
-//! Is each image where the database's matches put it? An image's verified matches to other
-//! images' keypoints that lie on 3D points of the model are 2D-3D correspondences; the pose
+//! Is each image where the database's matches put it? An image's keypoints on 3D points of
+//! the model, and its verified matches to other images' keypoints on them, are 2D-3D
+//! correspondences; the pose
 //! most of them agree with (RANSAC on P3P, OpenCV's `solvePnPRansac`) is where the matches
 //! place the image. A camera that the model holds between its true neighbours and the false
 //! matches of another copy (the demo's image 0000 with the global mapper: 13-22% of the
