@@ -350,6 +350,12 @@ fn spread(model: &SparseModel) -> f64 {
         .values()
         .map(|p| Vector3::new(p[0], p[1], p[2]))
         .collect();
+    spread_of(&points)
+}
+
+/// The median distance of `points` to their centroid (0 without points): the scale the check's
+/// distances are measured in.
+pub(super) fn spread_of(points: &[Vector3<f64>]) -> f64 {
     if points.is_empty() {
         return 0.0;
     }

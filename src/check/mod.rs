@@ -65,6 +65,13 @@ pub struct Split {
     pub joining_pairs: Vec<JoiningPair>,
 }
 
+impl Split {
+    /// One image alone against the rest (a camera on the wrong copy).
+    pub fn alone(&self) -> bool {
+        self.groups.iter().any(|g| g.len() == 1)
+    }
+}
+
 /// The check of one model.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModelCheck<'e> {
@@ -107,10 +114,12 @@ impl ModelCheck<'_> {
     /// Ghosted, a group of it misplaced, or images in it unanchored: the model is wrong where
     /// the check can tell.
     pub fn wrong(&self) -> bool {
-        self.ghosted
-            || self.misplaced.is_some()
-            || !self.misplaced_images.is_empty()
-            || !self.unanchored.is_empty()
+        self.ghosted || self.places_elsewhere() || !self.unanchored.is_empty()
+    }
+
+    /// The database's matches place a group or an image of it elsewhere than the model does.
+    pub fn places_elsewhere(&self) -> bool {
+        self.misplaced.is_some() || !self.misplaced_images.is_empty()
     }
 }
 
@@ -392,18 +401,16 @@ pub fn check_run<'e>(
         Some(e) => {
             for (k, (model, c)) in models.iter().zip(&mut checks).enumerate() {
                 let Some(worst) = &c.worst else { continue };
+                let placed = join::place_group(k, model, &worst.groups, e, settings, c.ghosted)?;
                 if c.ghosted {
-                    c.ghost_placement =
-                        join::place_group(k, model, &worst.groups, e, settings, true)?;
-                    // A split the matches cannot place may be one image off, not two groups.
-                    if let (None, Some(views)) = (&c.ghost_placement, &c.views) {
-                        c.misplaced_images = resection::misplaced_images(views)?;
-                    }
+                    c.ghost_placement = placed;
                 } else {
-                    c.misplaced = join::place_group(k, model, &worst.groups, e, settings, false)?;
-                    if let Some(views) = &c.views {
-                        c.misplaced_images = resection::misplaced_images(views)?;
-                    }
+                    c.misplaced = placed;
+                }
+                // Every image of a clean model; a ghost's split the matches cannot place may
+                // be one image off, not two groups.
+                if let (false, Some(views)) = (c.ghosted && c.ghost_placement.is_some(), &c.views) {
+                    c.misplaced_images = resection::misplaced_images(views)?;
                 }
             }
             let checked: Vec<_> = models
@@ -433,7 +440,7 @@ impl RunCheck<'_> {
         // images at 0.51; its 323 pairs blamed, the next run registered 28 of 44).
         // An image alone keeps its own blame.
         let group_ghost = |c: &&ModelCheck| {
-            let alone = (c.worst.iter()).any(|w| w.groups.iter().any(|g| g.len() == 1));
+            let alone = c.worst.as_ref().is_some_and(Split::alone);
             c.ghosted && (alone || c.ghost_placement.is_some() || c.misplaced_images.is_empty())
         };
         for worst in self
@@ -442,8 +449,11 @@ impl RunCheck<'_> {
             .filter(group_ghost)
             .flat_map(|c| &c.worst)
         {
-            let alone = worst.groups.iter().any(|g| g.len() == 1);
-            for p in worst.joining_pairs.iter().filter(|p| blames(p, alone)) {
+            for p in worst
+                .joining_pairs
+                .iter()
+                .filter(|p| blames(p, worst.alone()))
+            {
                 blamed.insert([p.image1.clone(), p.image2.clone()]);
             }
         }

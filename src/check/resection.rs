@@ -8,7 +8,7 @@
 //! matches, pruned or not, place it back. The pairs that agree with that pose are the links
 //! `prune --model` keeps; those that agree with the model's pose instead are blamed.
 
-use super::join::MISPLACED_DISTANCE;
+use super::join::{spread_of, MISPLACED_DISTANCE};
 use super::views::Views;
 use anyhow::Result;
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -87,21 +87,12 @@ fn correspondences(views: &Views, v: usize) -> Vec<([f64; 2], usize, usize)> {
     out
 }
 
-/// The model's spread: the median distance of its points to their centroid.
-pub fn spread(views: &Views) -> f64 {
-    let n = views.points.len().max(1) as f64;
-    let centroid = views.points.iter().sum::<Vector3<f64>>() / n;
-    let mut d: Vec<f64> = views.points.iter().map(|p| (p - centroid).norm()).collect();
-    d.sort_by(f64::total_cmp);
-    d.get(d.len() / 2).copied().unwrap_or(0.0)
-}
-
 /// The images of `views` (with a database) whose matches place them elsewhere than the model:
 /// more than [`MISPLACED_DISTANCE`] of the model's spread away and at most [`MAX_MOVED`]
 /// times it, by at least [`SUPPORT_RATIO`] times the correspondences that support the
 /// model's pose.
 pub fn misplaced_images(views: &Views) -> Result<Vec<MisplacedImage>> {
-    let spread = spread(views);
+    let spread = spread_of(&views.points);
     let placed: Vec<Option<MisplacedImage>> = (0..views.views.len())
         .into_par_iter()
         .map(|v| place(views, v, spread))

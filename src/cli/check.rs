@@ -77,7 +77,7 @@ impl CheckArgs {
 fn verdict(c: &ModelCheck) -> &'static str {
     if c.ghosted {
         "ghosted"
-    } else if c.misplaced.is_some() || !c.misplaced_images.is_empty() {
+    } else if c.places_elsewhere() {
         "misplaced"
     } else if !c.unanchored.is_empty() {
         "unanchored"
@@ -259,8 +259,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
         reports.push(value);
     }
     let ghosted = run.models.iter().any(|c| c.ghosted);
-    let misplaced =
-        (run.models.iter()).any(|c| c.misplaced.is_some() || !c.misplaced_images.is_empty());
+    let misplaced = run.models.iter().any(ModelCheck::places_elsewhere);
     let unanchored = run.models.iter().any(|c| !c.unanchored.is_empty());
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
