@@ -131,13 +131,17 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
         .unwrap();
         let model = work.join(format!("sparse_{variant}"));
         let db = work.join(format!("{variant}.db"));
+        let report = work.join(format!("check_{variant}.json"));
         let out = vgsel(&[
             "check",
             "--model",
             model.to_str().unwrap(),
             "--database_path",
             db.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
         ]);
+        placements_agree_with_the_check(&model, &db, &dir.path().join("gt"), &report);
         let line = String::from_utf8_lossy(&out.stdout).to_string();
         eprintln!(
             "{variant}: {} of {} correct; {line}",
@@ -155,6 +159,53 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
     // The full database ghosts and the pruned one does not, as a rule (tests/e2e.rs): recorded.
     eprintln!("exit statuses full, pruned: {verdicts:?}");
     repair_from_the_full_model(&work, &dir.path().join("images"), &dir.path().join("gt"));
+}
+
+/// `eval --placements` places every registered image (each has far more than 30
+/// correspondences here), scores it against the ground truth, and calls misplaced exactly the
+/// images the check's report does.
+fn placements_agree_with_the_check(model: &Path, db: &Path, gt: &Path, report: &Path) {
+    let csv = model.with_extension("placements.csv");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let out = vgsel(&[
+        "eval",
+        "--model",
+        &s(model),
+        "--ground_truth",
+        &s(gt),
+        "--database_path",
+        &s(db),
+        "--placements",
+        &s(&csv),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let eval: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("model,image,correct,moved,support,model_support,correspondences,misplaced")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(
+        Some(rows.len() as u64),
+        eval["registered"].as_u64(),
+        "{text}"
+    );
+    let correct = rows.iter().filter(|r| r[2] == "1").count() as u64;
+    assert_eq!(Some(correct), eval["correct"].as_u64(), "{text}");
+    let mut misplaced: Vec<&str> = rows.iter().filter(|r| r[7] == "1").map(|r| r[1]).collect();
+    misplaced.sort();
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    let mut named: Vec<&str> = report["models"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|m| m["misplaced_images"].as_array().unwrap())
+        .map(|m| m["image"].as_str().unwrap())
+        .collect();
+    named.sort();
+    assert_eq!(misplaced, named, "{text}");
 }
 
 /// The repair loop's second step on the full database's model: `prune --model` with the general

@@ -97,7 +97,7 @@ pub struct ModelCheck<'e> {
     /// With the database, for a model the conflicts call clean, or ghosted by a split whose
     /// second group the matches cannot place: images its matches place elsewhere
     /// ([`resection`]). The model is wrong.
-    pub misplaced_images: Vec<resection::MisplacedImage>,
+    pub misplaced_images: Vec<resection::ImagePlacement>,
     /// Registered images of a model that has points whose poses rest on (next to) nothing it
     /// holds: no point, or points for under [`ANCHORED_FRACTION`] of their matched keypoints;
     /// sorted.

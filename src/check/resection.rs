@@ -43,9 +43,9 @@ pub const MAX_MOVED: f64 = 1.5;
 /// correspondences.
 pub const PAIR_MIN_CORRESPONDENCES: usize = 5;
 
-/// An image the database's matches place elsewhere than the model does.
+/// Where the database's matches put one image, next to where the model put it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct MisplacedImage {
+pub struct ImagePlacement {
     /// Image name.
     pub image: String,
     /// Its correspondences: its keypoints on a 3D point of the model, and its keypoints
@@ -59,13 +59,24 @@ pub struct MisplacedImage {
     /// distance of its points to their centroid).
     pub moved: f64,
     /// The pairs (this image, another) with at least [`PAIR_MIN_CORRESPONDENCES`]
-    /// correspondences, at least half of them agreeing with the matches' pose: they place it
-    /// back (`prune --model` keeps them).
+    /// correspondences, at least half of them agreeing with the matches' pose: for a
+    /// misplaced image, they place it back (`prune --model` keeps them).
     pub links: Vec<[String; 2]>,
     /// The pairs with as many correspondences, at least half of them agreeing with the
-    /// model's pose and more than with the matches': they hold it where the model put it
-    /// (`prune --model` blames them).
+    /// model's pose and more than with the matches': for a misplaced image, they hold it
+    /// where the model put it (`prune --model` blames them).
     pub against: Vec<[String; 2]>,
+}
+
+impl ImagePlacement {
+    /// The model put the image where its matches do not: they move it by more than
+    /// [`MISPLACED_DISTANCE`] of the model's spread and at most [`MAX_MOVED`] times it, with
+    /// at least [`MIN_SUPPORT`] correspondences and [`SUPPORT_RATIO`] times the model pose's.
+    pub fn misplaced(&self) -> bool {
+        (MISPLACED_DISTANCE..=MAX_MOVED).contains(&self.moved)
+            && self.support >= MIN_SUPPORT
+            && self.support as f64 >= SUPPORT_RATIO * self.model_support as f64
+    }
 }
 
 /// View `v`'s correspondences: (keypoint pixel, 3D point index, the view whose keypoint is on
@@ -87,24 +98,31 @@ fn correspondences(views: &Views, v: usize) -> Vec<([f64; 2], usize, usize)> {
     out
 }
 
-/// The images of `views` (with a database) whose matches place them elsewhere than the model:
-/// more than [`MISPLACED_DISTANCE`] of the model's spread away and at most [`MAX_MOVED`]
-/// times it, by at least [`SUPPORT_RATIO`] times the correspondences that support the
-/// model's pose.
-pub fn misplaced_images(views: &Views) -> Result<Vec<MisplacedImage>> {
+/// Where the database's matches put each image of `views` (with a database): every image
+/// with at least [`MIN_SUPPORT`] correspondences and a pose they agree on, in view order.
+/// The evaluation compares these with the ground truth (`eval --placements`).
+pub fn image_placements(views: &Views) -> Result<Vec<ImagePlacement>> {
     let spread = spread_of(&views.points);
-    let placed: Vec<Option<MisplacedImage>> = (0..views.views.len())
+    let placed: Vec<Option<ImagePlacement>> = (0..views.views.len())
         .into_par_iter()
         .map(|v| place(views, v, spread))
         .collect::<Result<_>>()?;
     Ok(placed.into_iter().flatten().collect())
 }
 
+/// The images of `views` (with a database) whose matches place them elsewhere than the model
+/// ([`ImagePlacement::misplaced`]).
+pub fn misplaced_images(views: &Views) -> Result<Vec<ImagePlacement>> {
+    let mut placed = image_placements(views)?;
+    placed.retain(ImagePlacement::misplaced);
+    Ok(placed)
+}
+
 /// A world-to-camera rotation and translation.
 type Pose = (Matrix3<f64>, Vector3<f64>);
 
-/// [`misplaced_images`] for view `v`: `Some` where it is misplaced.
-fn place(views: &Views, v: usize, spread: f64) -> Result<Option<MisplacedImage>> {
+/// [`image_placements`] for view `v`: `None` with too few correspondences or no pose.
+fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>> {
     let c = correspondences(views, v);
     if c.len() < MIN_SUPPORT {
         return Ok(None);
@@ -135,12 +153,6 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<MisplacedImage>>
         }
     }
     let moved = (-(rotation.transpose() * translation) - view.centre).norm() / spread;
-    let misplaced = (MISPLACED_DISTANCE..=MAX_MOVED).contains(&moved)
-        && support >= MIN_SUPPORT
-        && support as f64 >= SUPPORT_RATIO * model_support as f64;
-    if !misplaced {
-        return Ok(None);
-    }
     let named = |w: usize| [view.name.clone(), views.views[w].name.clone()];
     let judged = pairs.iter().filter(|p| p.1[0] >= PAIR_MIN_CORRESPONDENCES);
     let list = |keep: &dyn Fn(&[usize; 3]) -> bool| -> Vec<[String; 2]> {
@@ -150,7 +162,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<MisplacedImage>>
             .map(|p| named(p.0))
             .collect()
     };
-    Ok(Some(MisplacedImage {
+    Ok(Some(ImagePlacement {
         image: view.name.clone(),
         correspondences: c.len(),
         model_support,

@@ -793,6 +793,11 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     let in_place = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
     assert!(in_place.models[0].misplaced_images.is_empty());
     assert!(!in_place.models[0].wrong());
+    // Every image is placed, where the model has it.
+    let views = in_place.models[0].views.as_ref().unwrap();
+    let placed = resection::image_placements(views).unwrap();
+    assert_eq!(placed.len(), views.views.len());
+    assert!(placed.iter().all(|p| p.moved < 0.01), "{placed:?}");
     let (model, evidence) = with_shift(1.0);
     let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
     let c = &run.models[0];
@@ -815,11 +820,14 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     let (model, evidence) = with_shift(5.0);
     let far = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
     assert!(far.models[0].misplaced_images.is_empty());
+    let placed = resection::image_placements(far.models[0].views.as_ref().unwrap()).unwrap();
+    let p = placed.iter().find(|p| p.image == "0005.png").unwrap();
+    assert!(p.moved > resection::MAX_MOVED && !p.misplaced(), "{p:?}");
 }
 
 /// A ghost of two groups of two images whose split joins a-c (sharing points) and b-d (not),
 /// with `images` its matches place elsewhere, and its second group `placed` or not.
-fn ghost_of_two(images: Vec<resection::MisplacedImage>, placed: bool) -> ModelCheck<'static> {
+fn ghost_of_two(images: Vec<resection::ImagePlacement>, placed: bool) -> ModelCheck<'static> {
     let pair = |a: &str, b: &str, shared: usize| JoiningPair {
         image1: a.into(),
         image2: b.into(),
@@ -872,7 +880,7 @@ fn ghost_of_two(images: Vec<resection::MisplacedImage>, placed: bool) -> ModelCh
 /// blamed; an image alone keeps its own blame.
 #[test]
 fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_image() {
-    let image = resection::MisplacedImage {
+    let image = resection::ImagePlacement {
         image: "c.png".into(),
         correspondences: 100,
         model_support: 10,

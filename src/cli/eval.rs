@@ -4,7 +4,13 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
+use vgsel_colmap::check::evidence::Evidence;
+use vgsel_colmap::check::resection::{image_placements, ImagePlacement};
+use vgsel_colmap::check::settings::DEFAULT_SETTINGS;
+use vgsel_colmap::check::views::Views;
 use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::model::model_dirs;
+use vgsel_colmap::colmap::sparse::read_sparse_model;
 use vgsel_colmap::eval::{pair_truth, score as eval};
 
 #[derive(Args)]
@@ -29,14 +35,23 @@ pub struct EvalArgs {
     /// as CSV, keyed by image ids like `prune --scores`, to measure priors against the truth.
     #[arg(long, value_name = "FILE", requires_all = ["database_path", "ground_truth"])]
     labels: Option<PathBuf>,
+    /// Write, for every registered image, where the database's matches put it (the check's
+    /// misplaced-image test, docs/check.md) next to its ground-truth verdict, as CSV: to
+    /// measure that test's settings against the truth (`scripts/lab/evidence-truth.py`).
+    #[arg(long, value_name = "FILE", requires = "database_path")]
+    placements: Option<PathBuf>,
     /// A pair is used by the mapper with at least this many inliers (--Mapper.min_num_matches).
     #[arg(long, default_value_t = vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
 }
 
 pub fn run(args: &EvalArgs) -> Result<()> {
-    let mut value = match &args.ground_truth {
-        Some(gt) => serde_json::to_value(eval::score(&args.model, gt)?)?,
+    let scores = match &args.ground_truth {
+        Some(gt) => Some(eval::score(&args.model, gt)?),
+        None => None,
+    };
+    let mut value = match &scores {
+        Some(s) => serde_json::to_value(s)?,
         None => serde_json::to_value(eval::registered(&args.model)?)?,
     };
     if let Some(db) = &args.database_path {
@@ -62,6 +77,50 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         std::fs::write(path, pair_truth::labels_csv(db, gt)?)
             .with_context(|| format!("writing {}", path.display()))?;
     }
+    if let (Some(path), Some(db)) = (&args.placements, &args.database_path) {
+        std::fs::write(path, placements_csv(&args.model, db, scores.as_ref())?)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     println!("{}", serde_json::to_string_pretty(&value)?);
     Ok(())
+}
+
+/// `--placements`' CSV: per sub-model (its index) and image, the ground truth's verdict where
+/// there is one (1 correct, 0 not, empty unknown), then [`ImagePlacement`]'s numbers and
+/// verdict.
+fn placements_csv(
+    model: &std::path::Path,
+    db: &std::path::Path,
+    scores: Option<&eval::Scores>,
+) -> Result<String> {
+    let evidence = Evidence::load(&Database::open_read_only(db)?)?;
+    let mut out =
+        String::from("model,image,correct,moved,support,model_support,correspondences,misplaced\n");
+    for (index, dir) in model_dirs(model)?.iter().enumerate() {
+        let sparse = read_sparse_model(dir)?;
+        let views = Views::new(&sparse, DEFAULT_SETTINGS.conflict.radius, Some(&evidence))?;
+        for p in image_placements(&views)? {
+            let correct = scores
+                .and_then(|s| {
+                    s.images
+                        .iter()
+                        .find(|i| i.model == index && i.name == p.image)
+                })
+                .map_or(String::new(), |i| u8::from(i.correct).to_string());
+            let ImagePlacement {
+                image,
+                moved,
+                support,
+                model_support,
+                correspondences,
+                ..
+            } = &p;
+            out.push_str(&format!(
+                "{index},{image},{correct},{moved:.4},{support},{model_support},\
+                 {correspondences},{}\n",
+                u8::from(p.misplaced())
+            ));
+        }
+    }
+    Ok(out)
 }
