@@ -98,6 +98,10 @@ pub struct ModelCheck<'e> {
     /// second group the matches cannot place: images its matches place elsewhere
     /// ([`resection`]). The model is wrong.
     pub misplaced_images: Vec<resection::ImagePlacement>,
+    /// A ghost whose split is no longer ghosted once its misplaced images are left out: those
+    /// images are the ghost, not its groups (a street's camera one building off, taken for a
+    /// split of 16 against 28 images), and the repair acts on them alone.
+    pub ghost_of_images: bool,
     /// Registered images of a model that has points whose poses rest on (next to) nothing it
     /// holds: no point, or points for under [`ANCHORED_FRACTION`] of their matched keypoints;
     /// sorted.
@@ -189,6 +193,7 @@ pub fn check_model<'e>(
         misplaced: None,
         ghost_placement: None,
         misplaced_images: Vec::new(),
+        ghost_of_images: false,
         unanchored: unanchored(&views),
         side,
         views: Some(views),
@@ -401,7 +406,8 @@ pub fn check_run<'e>(
         Some(e) => {
             for (k, (model, c)) in models.iter().zip(&mut checks).enumerate() {
                 let Some(worst) = &c.worst else { continue };
-                let placed = join::place_group(k, model, &worst.groups, e, settings, c.ghosted)?;
+                let groups = worst.groups.clone();
+                let placed = join::place_group(k, model, &groups, e, settings, c.ghosted)?;
                 if c.ghosted {
                     c.ghost_placement = placed;
                 } else {
@@ -410,7 +416,21 @@ pub fn check_run<'e>(
                 // Every image of a clean model; a ghost's split the matches cannot place may
                 // be one image off, not two groups.
                 if let (false, Some(views)) = (c.ghosted && c.ghost_placement.is_some(), &c.views) {
-                    c.misplaced_images = resection::misplaced_images(views)?;
+                    let mut images = resection::misplaced_images(views)?;
+                    // An unanchored image's pose rests on nothing its matches could correct:
+                    // their pose is a registration afresh, which false matches to the other
+                    // copy can carry (a hall orbit registered without points: 13 such images,
+                    // their links false). The image is told as unanchored.
+                    images.retain(|m| !c.unanchored.contains(&m.image));
+                    c.misplaced_images = images;
+                }
+                if c.ghosted && !c.misplaced_images.is_empty() {
+                    let images: Vec<&str> = c
+                        .misplaced_images
+                        .iter()
+                        .map(|m| m.image.as_str())
+                        .collect();
+                    c.ghost_of_images = !ghosted_without(model, &groups, &images, e, settings)?;
                 }
             }
             let checked: Vec<_> = models
@@ -434,14 +454,13 @@ impl RunCheck<'_> {
     /// when a repair turn has nothing to act on (the loop's scripts stop there).
     pub fn evidence(&self) -> ModelEvidence {
         let mut blamed = std::collections::BTreeSet::new();
-        // A ghost whose second group the matches cannot place, but one of whose images they
-        // place elsewhere, is that image's: blaming every pair across its split would tear
-        // the model (street seed 19: one camera a building off, a split of 16 against 28
-        // images at 0.51; its 323 pairs blamed, the next run registered 28 of 44).
+        // A ghost that is its misplaced images is theirs: blaming every pair across its split
+        // would tear the model (street seed 19: one camera a building off, a split of 16
+        // against 28 images at 0.51; its 323 pairs blamed, the next run registered 28 of 44).
         // An image alone keeps its own blame.
         let group_ghost = |c: &&ModelCheck| {
             let alone = c.worst.as_ref().is_some_and(Split::alone);
-            c.ghosted && (alone || c.ghost_placement.is_some() || c.misplaced_images.is_empty())
+            c.ghosted && (alone || !c.ghost_of_images)
         };
         for worst in self
             .models
@@ -478,6 +497,28 @@ impl RunCheck<'_> {
             links: links.into_iter().collect(),
         }
     }
+}
+
+/// Whether the split into `groups` of `model` is still ghosted with `images` left out.
+fn ghosted_without(
+    model: &SparseModel,
+    groups: &[Vec<String>; 2],
+    images: &[&str],
+    evidence: &Evidence,
+    settings: &CheckSettings,
+) -> Result<bool> {
+    let mut rest = model.clone();
+    rest.images
+        .retain(|im| !images.contains(&im.image.name.as_str()));
+    let views = Views::new(&rest, settings.conflict.radius, Some(evidence))?;
+    let side: Vec<bool> = views
+        .views
+        .iter()
+        .map(|v| groups[1].contains(&v.name))
+        .collect();
+    let reach = conflict::Reach::new(&views, &settings.conflict);
+    let counts = conflict::count(&views, &reach, &side, &settings.conflict);
+    Ok(is_ghost(&counts, settings))
 }
 
 /// Whether a pair joining a ghost's two groups glued them: it shares points in the model. For

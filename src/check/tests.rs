@@ -169,6 +169,23 @@ fn a_ghosted_model_is_found_with_its_two_groups() {
     assert!(!worst.joining_pairs.is_empty());
 }
 
+/// A ghost's split is still ghosted without one of its images, not without a whole group:
+/// what `ghost_of_images` asks of a ghost's misplaced images.
+#[test]
+fn a_ghost_is_its_images_only_where_leaving_them_out_clears_it() {
+    let model = ghosted_model();
+    let check = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
+    let groups = check.worst.unwrap().groups;
+    let evidence = Evidence::default();
+    let without = |images: &[&str]| {
+        super::ghosted_without(&model, &groups, images, &evidence, &DEFAULT_SETTINGS).unwrap()
+    };
+    assert!(without(&[]));
+    assert!(without(&[groups[1][0].as_str()]));
+    let all: Vec<&str> = groups[1].iter().map(String::as_str).collect();
+    assert!(!without(&all));
+}
+
 /// The correct model's twelve cameras along one wall and a thirteenth among them that saw
 /// another wall, textured differently, at the same place: `misplaced` registers it there
 /// (a street's camera one building off; it shares with the rest only a small object in front);
@@ -823,11 +840,25 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     let placed = resection::image_placements(far.models[0].views.as_ref().unwrap()).unwrap();
     let p = placed.iter().find(|p| p.image == "0005.png").unwrap();
     assert!(p.moved > resection::MAX_MOVED && !p.misplaced(), "{p:?}");
+    // Registered on no point of its own, its matches' pose corrects nothing: the image is
+    // unanchored, not misplaced.
+    let (mut model, evidence) = with_shift(1.0);
+    for p in &mut model.images[4].points2d {
+        p.point3d_id = None;
+    }
+    let bare = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    assert_eq!(bare.models[0].unanchored, ["0005.png"]);
+    assert!(bare.models[0].misplaced_images.is_empty());
 }
 
 /// A ghost of two groups of two images whose split joins a-c (sharing points) and b-d (not),
-/// with `images` its matches place elsewhere, and its second group `placed` or not.
-fn ghost_of_two(images: Vec<resection::ImagePlacement>, placed: bool) -> ModelCheck<'static> {
+/// with `images` its matches place elsewhere (`of_images`: they are the ghost), and its second
+/// group `placed` or not.
+fn ghost_of_two(
+    images: Vec<resection::ImagePlacement>,
+    of_images: bool,
+    placed: bool,
+) -> ModelCheck<'static> {
     let pair = |a: &str, b: &str, shared: usize| JoiningPair {
         image1: a.into(),
         image2: b.into(),
@@ -868,16 +899,17 @@ fn ghost_of_two(images: Vec<resection::ImagePlacement>, placed: bool) -> ModelCh
             links: Vec::new(),
         }),
         misplaced_images: images,
+        ghost_of_images: of_images,
         unanchored: Vec::new(),
         side: Vec::new(),
         views: None,
     }
 }
 
-/// A ghost of groups the matches cannot place while they place one of its images elsewhere is
-/// that image's: the repair keeps and blames that image's pairs, not every pair across the
-/// split; with its group placed, or no image placed, the split's pairs that share points are
-/// blamed; an image alone keeps its own blame.
+/// A ghost that is its misplaced image (without it, its split is clean) is that image's: the
+/// repair keeps and blames that image's pairs, not every pair across the split; a ghost of
+/// groups (with or without a misplaced image, placed or not) has the split's pairs that share
+/// points blamed; an image alone keeps its own blame.
 #[test]
 fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_image() {
     let image = resection::ImagePlacement {
@@ -897,17 +929,24 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
         .evidence()
     };
     let named = |a: &str, b: &str| [a.to_string(), b.to_string()];
-    let as_image = evidence(ghost_of_two(vec![image.clone()], false));
+    let as_image = evidence(ghost_of_two(vec![image.clone()], true, false));
     assert_eq!(as_image.blamed, [named("c.png", "d.png")]);
     assert_eq!(as_image.links, [named("b.png", "c.png")]);
-    let as_groups = evidence(ghost_of_two(Vec::new(), false));
+    let as_groups = evidence(ghost_of_two(Vec::new(), false, false));
     assert_eq!(as_groups.blamed, [named("a.png", "c.png")]);
     assert!(as_groups.links.is_empty());
-    let placed = evidence(ghost_of_two(vec![image.clone()], true));
+    // Groups that stay a ghost without the image: theirs, and the image's evidence beside.
+    let both = evidence(ghost_of_two(vec![image.clone()], false, false));
+    assert_eq!(
+        both.blamed,
+        [named("a.png", "c.png"), named("c.png", "d.png")]
+    );
+    assert_eq!(both.links, [named("b.png", "c.png")]);
+    let placed = evidence(ghost_of_two(vec![image.clone()], false, true));
     assert!(placed.blamed.contains(&named("a.png", "c.png")));
     // An image alone keeps its blame (pairs whose matches the model joins), the misplaced
     // image's evidence beside it.
-    let mut alone = ghost_of_two(vec![image], false);
+    let mut alone = ghost_of_two(vec![image], true, false);
     let worst = alone.worst.as_mut().unwrap();
     worst.groups = [
         vec!["a.png".into(), "b.png".into(), "d.png".into()],

@@ -318,6 +318,7 @@ mod tests {
             misplaced: None,
             ghost_placement: None,
             misplaced_images: Vec::new(),
+            ghost_of_images: false,
             unanchored: Vec::new(),
             side: Vec::new(),
             views: None,
