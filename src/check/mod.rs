@@ -499,7 +499,9 @@ impl RunCheck<'_> {
     }
 }
 
-/// Whether the split into `groups` of `model` is still ghosted with `images` left out.
+/// Whether the split into `groups` of `model` is still ghosted with `images` left out. Where
+/// that leaves a group fewer than `min_group` images, the images are that group, and the ghost
+/// is still one of groups (a street's 11 images a building off, 16 of them placed apart).
 fn ghosted_without(
     model: &SparseModel,
     groups: &[Vec<String>; 2],
@@ -507,6 +509,10 @@ fn ghosted_without(
     evidence: &Evidence,
     settings: &CheckSettings,
 ) -> Result<bool> {
+    let left = |g: &Vec<String>| g.iter().filter(|n| !images.contains(&n.as_str())).count();
+    if groups.iter().any(|g| left(g) < settings.min_group) {
+        return Ok(true);
+    }
     let mut rest = model.clone();
     rest.images
         .retain(|im| !images.contains(&im.image.name.as_str()));

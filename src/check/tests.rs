@@ -169,8 +169,9 @@ fn a_ghosted_model_is_found_with_its_two_groups() {
     assert!(!worst.joining_pairs.is_empty());
 }
 
-/// A ghost's split is still ghosted without one of its images, not without a whole group:
-/// what `ghost_of_images` asks of a ghost's misplaced images.
+/// What `ghost_of_images` asks of a ghost's misplaced images: a ghost of groups stays one
+/// without one of its images, or with a whole group left out; a split that conflicts for one
+/// image's sake is clean without it.
 #[test]
 fn a_ghost_is_its_images_only_where_leaving_them_out_clears_it() {
     let model = ghosted_model();
@@ -182,8 +183,32 @@ fn a_ghost_is_its_images_only_where_leaving_them_out_clears_it() {
     };
     assert!(without(&[]));
     assert!(without(&[groups[1][0].as_str()]));
+    // A whole group left out is no split: the images are that group, a ghost of groups.
     let all: Vec<&str> = groups[1].iter().map(String::as_str).collect();
-    assert!(!without(&all));
+    assert!(without(&all));
+    // A camera on the other wall among correct ones: a split whose second group holds it
+    // conflicts for its sake alone (0.13 against 0.008 without it; a threshold of 0.1 here).
+    let model = one_image_model(true);
+    let mut names: Vec<String> = model
+        .images
+        .iter()
+        .map(|im| im.image.name.clone())
+        .collect();
+    let odd = names.pop().unwrap();
+    let groups = [
+        names[..6].to_vec(),
+        [&names[6..], &[odd.clone()][..]].concat(),
+    ];
+    let settings = CheckSettings {
+        threshold: 0.1,
+        ..DEFAULT_SETTINGS
+    };
+    let without = |images: &[&str]| {
+        super::ghosted_without(&model, &groups, images, &evidence, &settings).unwrap()
+    };
+    assert!(without(&[]));
+    assert!(!without(&[odd.as_str()]));
+    assert!(without(&[names[0].as_str()]));
 }
 
 /// The correct model's twelve cameras along one wall and a thirteenth among them that saw
