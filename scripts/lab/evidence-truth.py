@@ -76,11 +76,14 @@ def sourced_pairs(report):
         for source in ("ghost_placement", "misplaced"):
             for link in (m.get(source) or {}).get("links", []):
                 yield f"{source} link", key(link["image1"], link["image2"])
-        for image in m.get("misplaced_images", []):
+        alone = any(len(g) == 1 for g in m["worst"]["groups"]) if m["worst"] else False
+        state = ("clean model" if not m["ghosted"] else "image alone" if alone else
+                 "ghost of images" if m["ghost_of_images"] else "ghost of groups")
+        for image in m["misplaced_images"]:
             for a, b in image["links"]:
-                yield "misplaced_image link", key(a, b)
+                yield f"misplaced_image link, {state}", key(a, b)
             for a, b in image["against"]:
-                yield "misplaced_image against", key(a, b)
+                yield f"misplaced_image against, {state}", key(a, b)
     for join in report["joins"]:
         for link in join["links"]:
             yield "join link", key(link["image1"], link["image2"])
