@@ -477,8 +477,8 @@ impl RunCheck<'_> {
             }
         }
         // A ghost of groups acts by its groups alone: there each image's matches are pulled by
-        // both copies, and its misplaced images' links were 60% true (138 of 229, loops of
-        // sessions 15-19, `scripts/lab/evidence-truth.py`), the pairs against them half.
+        // both copies; its misplaced images' links were 62 true of 146, and the 9 pairs
+        // against them all true (loops of sessions 15-19, `scripts/lab/evidence-truth.py`).
         let of_groups = |c: &&ModelCheck| {
             let alone = c.worst.as_ref().is_some_and(Split::alone);
             c.ghosted && !alone && !c.ghost_of_images
