@@ -125,6 +125,15 @@ impl ModelCheck<'_> {
     pub fn places_elsewhere(&self) -> bool {
         self.misplaced.is_some() || !self.misplaced_images.is_empty()
     }
+
+    /// A ghost of two groups: not one image alone, nor its misplaced images. The repair acts
+    /// by its split alone, not by its misplaced images: there each image's matches are pulled
+    /// by both copies (their links were 62 true of 146, the 9 pairs against them all true;
+    /// loops of sessions 15-19, `scripts/lab/evidence-truth.py`).
+    pub fn ghost_of_groups(&self) -> bool {
+        let alone = self.worst.as_ref().is_some_and(Split::alone);
+        self.ghosted && !alone && !self.ghost_of_images
+    }
 }
 
 /// Checks one model, with the database's evidence if there is one (without: joining pairs are
@@ -458,14 +467,10 @@ impl RunCheck<'_> {
         // would tear the model (street seed 19: one camera a building off, a split of 16
         // against 28 images at 0.51; its 323 pairs blamed, the next run registered 28 of 44).
         // An image alone keeps its own blame.
-        let group_ghost = |c: &&ModelCheck| {
-            let alone = c.worst.as_ref().is_some_and(Split::alone);
-            c.ghosted && (alone || !c.ghost_of_images)
-        };
         for worst in self
             .models
             .iter()
-            .filter(group_ghost)
+            .filter(|c| c.ghosted && !c.ghost_of_images)
             .flat_map(|c| &c.worst)
         {
             for p in worst
@@ -476,17 +481,10 @@ impl RunCheck<'_> {
                 blamed.insert([p.image1.clone(), p.image2.clone()]);
             }
         }
-        // A ghost of groups acts by its groups alone: there each image's matches are pulled by
-        // both copies; its misplaced images' links were 62 true of 146, and the 9 pairs
-        // against them all true (loops of sessions 15-19, `scripts/lab/evidence-truth.py`).
-        let of_groups = |c: &&ModelCheck| {
-            let alone = c.worst.as_ref().is_some_and(Split::alone);
-            c.ghosted && !alone && !c.ghost_of_images
-        };
         let images = self
             .models
             .iter()
-            .filter(|c| !of_groups(c))
+            .filter(|c| !c.ghost_of_groups())
             .flat_map(|c| &c.misplaced_images);
         for pair in images.clone().flat_map(|m| &m.against) {
             blamed.insert(pair.clone());

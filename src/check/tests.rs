@@ -967,8 +967,9 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
     let placed = evidence(ghost_of_two(vec![image.clone()], false, true));
     assert!(placed.blamed.contains(&named("a.png", "c.png")));
     // An image alone keeps its blame (pairs whose matches the model joins), the misplaced
-    // image's evidence beside it.
-    let mut alone = ghost_of_two(vec![image], true, false);
+    // image's evidence beside it (it is never a ghost of images: without the image no split
+    // is left).
+    let mut alone = ghost_of_two(vec![image], false, false);
     let worst = alone.worst.as_mut().unwrap();
     worst.groups = [
         vec!["a.png".into(), "b.png".into(), "d.png".into()],
