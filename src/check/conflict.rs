@@ -6,7 +6,9 @@
 //! database matched b's keypoints there to A's (the same structure, kept as two tracks:
 //! [`super::evidence`]).
 
+use super::evidence::Evidence;
 use super::views::Views;
+use crate::colmap::sparse::SparseModel;
 use nalgebra::Vector3;
 use serde::Serialize;
 
@@ -193,6 +195,20 @@ pub fn count(views: &Views, reach: &Reach, side: &[bool], settings: &ConflictSet
         }
     }
     counts
+}
+
+/// [`count`] on `model`'s views built afresh (two models put together, or one with images left
+/// out), split into the images `in_b` names (group B) and the rest.
+pub fn count_model(
+    model: &SparseModel,
+    evidence: Option<&Evidence>,
+    settings: &ConflictSettings,
+    in_b: impl Fn(&str) -> bool,
+) -> anyhow::Result<Counts> {
+    let views = Views::new(model, settings.radius, evidence)?;
+    let side: Vec<bool> = views.views.iter().map(|v| in_b(&v.name)).collect();
+    let reach = Reach::new(&views, settings);
+    Ok(count(&views, &reach, &side, settings))
 }
 
 /// [`count`] of the split that puts view `b` alone in one group, in one pass over the points

@@ -22,7 +22,6 @@
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
 use super::settings::{score, CheckSettings};
-use super::views::Views;
 use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
 use crate::geometry::similarity::Similarity;
@@ -240,11 +239,11 @@ fn join_two(
             links.iter().map(|l| l.agreeing).sum()
         };
         if linked >= MIN_SUPPORT {
-            let (merged, side) = put_together(a, b, &placement);
-            let views = Views::new(&merged, settings.conflict.radius, Some(evidence))?;
-            let side: Vec<bool> = views.views.iter().map(|v| side.contains(&v.name)).collect();
-            let reach = conflict::Reach::new(&views, &settings.conflict);
-            let counts = conflict::count(&views, &reach, &side, &settings.conflict);
+            let (merged, from_b) = put_together(a, b, &placement);
+            let counts =
+                conflict::count_model(&merged, Some(evidence), &settings.conflict, |name| {
+                    from_b.contains(name)
+                })?;
             let score = score(&counts, settings);
             // The check's own verdict on the two models put together.
             if score >= settings.threshold && counts.conflicting >= settings.min_conflicts {

@@ -525,14 +525,8 @@ fn ghosted_without(
     let mut rest = model.clone();
     rest.images
         .retain(|im| !images.contains(&im.image.name.as_str()));
-    let views = Views::new(&rest, settings.conflict.radius, Some(evidence))?;
-    let side: Vec<bool> = views
-        .views
-        .iter()
-        .map(|v| groups[1].contains(&v.name))
-        .collect();
-    let reach = conflict::Reach::new(&views, &settings.conflict);
-    let counts = conflict::count(&views, &reach, &side, &settings.conflict);
+    let in_b = |name: &str| groups[1].iter().any(|n| n == name);
+    let counts = conflict::count_model(&rest, Some(evidence), &settings.conflict, in_b)?;
     Ok(is_ghost(&counts, settings))
 }
 
