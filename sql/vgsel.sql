@@ -10,6 +10,13 @@ CREATE TABLE IF NOT EXISTS vgsel_backup (
     rows, cols, data, config, F, E, H, qvec, tvec, camera1, camera2
 );
 
+-- The backed-up pairs a prune kept with fewer inliers rather than invalidated (`prune --model`
+-- drops the matches that held a misplaced image where a model put it): their rows in
+-- two_view_geometries stay valid, with the remaining inliers.
+CREATE TABLE IF NOT EXISTS vgsel_trimmed (
+    pair_id  INTEGER PRIMARY KEY NOT NULL
+);
+
 -- One row per prune, for reports and for telling a user what was done to the file.
 CREATE TABLE IF NOT EXISTS vgsel_runs (
     run_id          INTEGER PRIMARY KEY,

@@ -5,7 +5,7 @@
 use crate::support::*;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::ids::pair_id;
-use vgsel_colmap::colmap::rewrite::{apply, restore, RunRecord};
+use vgsel_colmap::colmap::rewrite::{apply, restore, Edits, RunRecord};
 
 /// What COLMAP 4.2 does to a 3.8 database when it opens it, for the values of the fixture: the
 /// placeholder pose (identity and zero translation, or a zero quaternion) and empty or zero
@@ -36,7 +36,7 @@ fn prune(path: &std::path::Path, pairs: &[(u32, u32)]) {
         pairs_total: 4,
         pairs_selected: 4 - pairs.len(),
     };
-    apply(&mut db, &ids, &run).unwrap();
+    apply(&mut db, &Edits::invalidating(ids.clone()), &run).unwrap();
 }
 
 /// The pairs pruned hold every case of the migration: (1, 2) the placeholder pose, (1, 3) an

@@ -8,7 +8,7 @@ use std::time::Duration;
 use vgsel_colmap::colmap::copy::copy_database;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::ids::pair_id;
-use vgsel_colmap::colmap::rewrite::{apply, last_run, restore, RunRecord};
+use vgsel_colmap::colmap::rewrite::{apply, last_run, restore, Edits, RunRecord, Trim};
 
 fn run(n: usize) -> RunRecord<serde_json::Value> {
     RunRecord {
@@ -27,7 +27,7 @@ fn ids(pairs: &[(u32, u32)]) -> Vec<u64> {
 
 fn prune(path: &Path, pairs: &[(u32, u32)]) {
     let mut db = Database::open(path).unwrap();
-    apply(&mut db, &ids(pairs), &run(pairs.len())).unwrap();
+    apply(&mut db, &Edits::invalidating(ids(pairs)), &run(pairs.len())).unwrap();
 }
 
 /// COLMAP's tables' sqlite_master entries (the project's own are left out).
@@ -213,6 +213,89 @@ fn restore_after_any_sequence_gives_the_original_rows() {
     }
 }
 
+/// A trimmed pair stays valid with the inliers given (rows and data only; its geometry as it
+/// was), its original row backed up; an invalidated one beside it as ever; readers of the
+/// original verification see both as verified; restore gives every row back byte for byte.
+#[test]
+fn a_trimmed_pair_stays_valid_with_fewer_inliers_and_restore_gives_it_back() {
+    for layout in SCHEMAS {
+        let (_d, path) = fixture(layout);
+        let original = dump(&path, "two_view_geometries");
+        let db = Database::open(&path).unwrap();
+        let verified = db.verified_pairs().unwrap();
+        let inliers = |a, b| {
+            let p = verified
+                .iter()
+                .find(|p| (p.image_id1, p.image_id2) == (a, b));
+            p.unwrap().inliers.clone()
+        };
+        let kept: Vec<[u32; 2]> = inliers(1, 2).into_iter().step_by(2).collect();
+        assert!(kept.len() < inliers(1, 2).len());
+        let edits = Edits {
+            invalidate: ids(&[(2, 3)]),
+            trim: vec![Trim {
+                pair_id: pair_id(1, 2),
+                inliers: kept.clone(),
+            }],
+        };
+        drop(db);
+        let mut db = Database::open(&path).unwrap();
+        apply(&mut db, &edits, &run(2)).unwrap();
+        drop(db);
+
+        let after = dump(&path, "two_view_geometries");
+        let (before, now) = (row_of(&original, (1, 2)), row_of(&after, (1, 2)));
+        assert_eq!(now[1], int(kept.len() as i64), "{layout:?}");
+        assert_eq!(now[2], int(2));
+        let data: Vec<u8> = kept
+            .iter()
+            .flatten()
+            .flat_map(|k| k.to_le_bytes())
+            .collect();
+        assert_eq!(now[3], ("blob".into(), Value::Blob(data)));
+        assert_eq!(now[4..], before[4..], "{layout:?}: the geometry stays");
+        for (b, n) in original.iter().zip(&after) {
+            if ![pair_id(1, 2), pair_id(2, 3)].contains(
+                &(match n[0].1 {
+                    Value::Integer(i) => i as u64,
+                    _ => panic!(),
+                }),
+            ) {
+                assert_eq!(n, b);
+            }
+        }
+        let db = Database::open(&path).unwrap();
+        assert_eq!(
+            db.invalidated_pair_ids().unwrap(),
+            [pair_id(2, 3)].into_iter().collect()
+        );
+        let orig = fixture(layout);
+        assert_eq!(
+            db.verified_pairs().unwrap(),
+            Database::open(&orig.1).unwrap().verified_pairs().unwrap()
+        );
+        drop(db);
+
+        // Trimmed and invalidated at once: refused, nothing written.
+        let bytes = std::fs::read(&path).unwrap();
+        let mut db = Database::open(&path).unwrap();
+        let twice = Edits {
+            invalidate: ids(&[(1, 2)]),
+            ..edits
+        };
+        let e = apply(&mut db, &twice, &run(1)).unwrap_err();
+        assert!(format!("{e:#}").contains("is edited twice"), "{e:#}");
+        drop(db);
+        assert_eq!(std::fs::read(&path).unwrap(), bytes);
+
+        let mut db = Database::open(&path).unwrap();
+        assert_eq!(restore(&mut db).unwrap(), 2);
+        drop(db);
+        assert_eq!(dump(&path, "two_view_geometries"), original, "{layout:?}");
+        assert!(table_names(&path).iter().all(|t| !t.starts_with("vgsel_")));
+    }
+}
+
 #[test]
 fn restore_brings_back_a_row_deleted_after_the_prune() {
     let (_d, path) = fixture(Schema::Latest);
@@ -253,7 +336,7 @@ fn a_failing_apply_leaves_the_file_byte_identical() {
         let mut db = Database::open(&path).unwrap();
         let mut list = ids(&A);
         list.push(pair_id(2, 99)); // no such row
-        let e = apply(&mut db, &list, &run(1)).unwrap_err();
+        let e = apply(&mut db, &Edits::invalidating(list.clone()), &run(1)).unwrap_err();
         assert_eq!(
             format!("{e:#}"),
             format!(
@@ -268,7 +351,7 @@ fn a_failing_apply_leaves_the_file_byte_identical() {
         prune(&path, &B);
         let bytes = std::fs::read(&path).unwrap();
         let mut db = Database::open(&path).unwrap();
-        assert!(apply(&mut db, &list, &run(1)).is_err());
+        assert!(apply(&mut db, &Edits::invalidating(list.clone()), &run(1)).is_err());
         drop(db);
         assert_eq!(std::fs::read(&path).unwrap(), bytes, "{layout:?}");
     }
@@ -282,14 +365,18 @@ fn apply_on_a_locked_or_read_only_database_fails_clearly() {
     db.set_busy_timeout(Duration::from_millis(100)).unwrap();
     let other = Connection::open(&path).unwrap();
     other.execute_batch("BEGIN IMMEDIATE;").unwrap();
-    let e = apply(&mut db, &ids(&A), &run(1)).unwrap_err().to_string();
+    let e = apply(&mut db, &Edits::invalidating(ids(&A)), &run(1))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("database is locked by another process"), "{e}");
     other.execute_batch("ROLLBACK;").unwrap();
     drop(db);
     assert_eq!(std::fs::read(&path).unwrap(), bytes);
 
     let mut ro = Database::open_read_only(&path).unwrap();
-    let e = apply(&mut ro, &ids(&A), &run(1)).unwrap_err().to_string();
+    let e = apply(&mut ro, &Edits::invalidating(ids(&A)), &run(1))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("read-only"), "{e}");
     assert_eq!(std::fs::read(&path).unwrap(), bytes);
 }
@@ -405,7 +492,12 @@ fn large_database_is_fast_enough() {
     assert_eq!(db.verified_pairs().unwrap().len(), 100_000);
     let read = t.elapsed();
     let t = Instant::now();
-    apply(&mut db, &all[..90_000], &run(10_000)).unwrap();
+    apply(
+        &mut db,
+        &Edits::invalidating(all[..90_000].to_vec()),
+        &run(10_000),
+    )
+    .unwrap();
     let pruned = t.elapsed();
     let t = Instant::now();
     assert_eq!(db.verified_pairs().unwrap().len(), 100_000);

@@ -301,11 +301,11 @@ fn write_database(
     pause_for_tests();
     let target = match &args.output {
         None => {
-            rewrite::apply_if_unchanged(db, plan.data_version, &plan.invalidate, &run)?;
+            rewrite::apply_if_unchanged(db, plan.data_version, &plan.edits, &run)?;
             &args.database.database_path
         }
         Some(out) => {
-            copy::write_pruned_copy(db, Some(plan.data_version), out, &plan.invalidate, &run)
+            copy::write_pruned_copy(db, Some(plan.data_version), out, &plan.edits, &run)
                 .with_context(|| format!("cannot write --output {}", out.display()))?;
             out
         }

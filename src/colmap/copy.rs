@@ -3,7 +3,7 @@
 //! of temporaries a killed run left behind.
 
 use crate::colmap::database::{sql_error, Database, SqlResult};
-use crate::colmap::rewrite::{apply, unchanged_since, RunRecord};
+use crate::colmap::rewrite::{apply, unchanged_since, Edits, RunRecord};
 use anyhow::{anyhow, bail, Context, Result};
 use rusqlite::OpenFlags;
 use serde::Serialize;
@@ -17,7 +17,7 @@ pub fn write_pruned_copy<P: Serialize>(
     input: &Database,
     read_version: Option<i64>,
     out: &Path,
-    invalidate: &[u64],
+    edits: &Edits,
     run: &RunRecord<P>,
 ) -> Result<()> {
     let name = out
@@ -29,7 +29,7 @@ pub fn write_pruned_copy<P: Serialize>(
     let result = (|| {
         copy_from(input, read_version, &tmp, true)?;
         let mut copy = Database::open(&tmp)?;
-        apply(&mut copy, invalidate, run)?;
+        apply(&mut copy, edits, run)?;
         drop(copy);
         std::fs::rename(&tmp, out)
             .with_context(|| format!("cannot move the pruned copy to {}", out.display()))

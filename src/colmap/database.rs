@@ -392,13 +392,19 @@ impl Database {
         )
     }
 
-    /// pair_ids of the pairs a prune invalidated (their original rows are in the backup table);
-    /// empty when the database was never pruned.
+    /// pair_ids of the pairs a prune invalidated (their original rows are in the backup table,
+    /// and they are not among the trimmed ones, which stay valid); empty when the database was
+    /// never pruned.
     pub fn invalidated_pair_ids(&self) -> Result<HashSet<u64>> {
         if !self.has_backup_table()? {
             return Ok(HashSet::new());
         }
-        self.pair_ids("SELECT pair_id FROM vgsel_backup", [])
+        let trimmed = if table_exists(&self.conn, "vgsel_trimmed").sql(&self.path)? {
+            " WHERE pair_id NOT IN (SELECT pair_id FROM vgsel_trimmed)"
+        } else {
+            ""
+        };
+        self.pair_ids(&format!("SELECT pair_id FROM vgsel_backup{trimmed}"), [])
     }
 
     /// The pair_id column of a query's rows.

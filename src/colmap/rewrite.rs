@@ -2,11 +2,13 @@
 //!
 //! An invalidated pair keeps its row with rows=0, cols=2, data=NULL, config=1 (DEGENERATE) and
 //! every geometry column NULL: COLMAP's incremental mapper skips rows=0, GLOMAP/global_mapper skip
-//! DEGENERATE, and a re-run matcher does not re-verify a pair whose row still exists. `matches`,
-//! `PRAGMA user_version` and COLMAP's table definitions are never touched. The original rows go to
-//! `vgsel_backup` (sql/vgsel.sql), whose untyped columns keep each value's storage class, so a
-//! restore is byte for byte.
+//! DEGENERATE, and a re-run matcher does not re-verify a pair whose row still exists. A trimmed
+//! pair stays valid with fewer inliers (rows and data only). `matches`, `PRAGMA user_version` and
+//! COLMAP's table definitions are never touched. The original rows of both go to `vgsel_backup`
+//! (sql/vgsel.sql), whose untyped columns keep each value's storage class, so a restore is byte
+//! for byte; `vgsel_trimmed` tells the trimmed ones.
 
+use crate::colmap::blob::encode_pairs;
 use crate::colmap::database::{data_version, Database, SqlResult};
 use crate::colmap::ids::{image_ids, TwoViewConfig};
 use crate::colmap::migration;
@@ -20,6 +22,35 @@ use std::path::Path;
 
 /// The project's tables (CREATE TABLE IF NOT EXISTS).
 pub const VGSEL_SQL: &str = include_str!("../../sql/vgsel.sql");
+
+/// What a prune writes into two_view_geometries, from the original rows.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Edits {
+    /// pair_ids of the pairs made invalid.
+    pub invalidate: Vec<u64>,
+    /// Pairs that stay valid with some of their inliers.
+    pub trim: Vec<Trim>,
+}
+
+impl Edits {
+    /// Edits that invalidate `pairs` and trim none.
+    pub fn invalidating(pairs: Vec<u64>) -> Edits {
+        Edits {
+            invalidate: pairs,
+            trim: Vec::new(),
+        }
+    }
+}
+
+/// A pair kept with fewer inliers: `prune --model` drops the matches that held a misplaced
+/// image where a model put it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trim {
+    /// The pair.
+    pub pair_id: u64,
+    /// The inliers it keeps (keypoint of the pair's first image, of its second, as stored).
+    pub inliers: Vec<[u32; 2]>,
+}
 
 /// What a prune records in the project's runs table: its parameters `P` (stored as JSON with
 /// sorted keys; this layer does not know what they mean) and what it selected.
@@ -91,15 +122,11 @@ fn ensure_writable(db: &Database) -> Result<()> {
     Ok(())
 }
 
-/// Makes exactly the pairs in `invalidate` (pair_ids) invalid, starting from the original rows
-/// (a previous prune is undone first), saves their original rows in the backup table and appends
-/// a run record; all in one transaction.
-pub fn apply<P: Serialize>(
-    db: &mut Database,
-    invalidate: &[u64],
-    run: &RunRecord<P>,
-) -> Result<()> {
-    apply_checked(db, None, invalidate, run)
+/// Makes exactly the pairs in `edits.invalidate` invalid and trims those in `edits.trim`,
+/// starting from the original rows (a previous prune is undone first), saves their original rows
+/// in the backup table and appends a run record; all in one transaction.
+pub fn apply<P: Serialize>(db: &mut Database, edits: &Edits, run: &RunRecord<P>) -> Result<()> {
+    apply_checked(db, None, edits, run)
 }
 
 /// [`apply`] to a database the selection was planned on, refusing (nothing written) when another
@@ -108,16 +135,16 @@ pub fn apply<P: Serialize>(
 pub fn apply_if_unchanged<P: Serialize>(
     db: &mut Database,
     read_version: i64,
-    invalidate: &[u64],
+    edits: &Edits,
     run: &RunRecord<P>,
 ) -> Result<()> {
-    apply_checked(db, Some(read_version), invalidate, run)
+    apply_checked(db, Some(read_version), edits, run)
 }
 
 fn apply_checked<P: Serialize>(
     db: &mut Database,
     read_version: Option<i64>,
-    invalidate: &[u64],
+    edits: &Edits,
     run: &RunRecord<P>,
 ) -> Result<()> {
     // Through a JSON value, whose maps are sorted: the stored text does not depend on field order.
@@ -127,7 +154,7 @@ fn apply_checked<P: Serialize>(
         if let Some(version) = read_version {
             unchanged_since(tx, p, version)?;
         }
-        apply_in(tx, columns, p, invalidate, &parameters, run)
+        apply_in(tx, columns, p, edits, &parameters, run)
     })
 }
 
@@ -183,14 +210,15 @@ fn apply_in<P>(
     tx: &Transaction,
     columns: &[&'static str],
     p: &Path,
-    invalidate: &[u64],
+    edits: &Edits,
     parameters: &str,
     run: &RunRecord<P>,
 ) -> Result<()> {
     tx.execute_batch(VGSEL_SQL).sql(p)?;
     migration::ensure_version_column(tx).sql(p)?;
     put_back(tx, columns).sql(p)?;
-    tx.execute("DELETE FROM vgsel_backup", []).sql(p)?;
+    tx.execute_batch("DELETE FROM vgsel_backup; DELETE FROM vgsel_trimmed;")
+        .sql(p)?;
 
     let copied: Vec<&str> = TWO_VIEW_COLUMNS
         .iter()
@@ -219,17 +247,41 @@ fn apply_in<P>(
             cleared.join(", ")
         ))
         .sql(p)?;
-    let unique: BTreeSet<u64> = invalidate.iter().copied().collect();
-    for &id in &unique {
+    let mut trim = tx
+        .prepare("UPDATE two_view_geometries SET rows = ?2, cols = 2, data = ?3 WHERE pair_id = ?1")
+        .sql(p)?;
+    let mut trimmed = tx
+        .prepare("INSERT INTO vgsel_trimmed (pair_id) VALUES (?1)")
+        .sql(p)?;
+    let unique: BTreeSet<u64> = edits.invalidate.iter().copied().collect();
+    let mut trims = BTreeSet::new();
+    if let Some(t) =
+        (edits.trim.iter()).find(|t| unique.contains(&t.pair_id) || !trims.insert(t.pair_id))
+    {
+        let (a, b) = image_ids(t.pair_id);
+        bail!("pair_id {} (images {a}, {b}) is edited twice (trimmed and invalidated, or trimmed twice)", t.pair_id);
+    }
+    let mut back_up = |id: u64, what: &str| -> Result<i64> {
         let (a, b) = image_ids(id);
         let raw = i64::try_from(id).map_err(|_| anyhow!("pair_id {id} out of range"))?;
         if backup.execute([raw]).sql(p)? == 0 {
-            bail!("cannot invalidate pair_id {id} (images {a}, {b}): it has no two_view_geometries row");
+            bail!(
+                "cannot {what} pair_id {id} (images {a}, {b}): it has no two_view_geometries row"
+            );
         }
-        clear.execute([raw]).sql(p)?;
+        Ok(raw)
+    };
+    for &id in &unique {
+        clear.execute([back_up(id, "invalidate")?]).sql(p)?;
     }
-    drop(backup);
-    drop(clear);
+    for t in &edits.trim {
+        let raw = back_up(t.pair_id, "trim")?;
+        let data = encode_pairs(&t.inliers);
+        trim.execute(rusqlite::params![raw, t.inliers.len() as i64, data])
+            .sql(p)?;
+        trimmed.execute([raw]).sql(p)?;
+    }
+    drop((backup, clear, trim, trimmed));
 
     let count = |n: usize| n as i64;
     tx.execute(
@@ -259,8 +311,11 @@ pub fn restore(db: &mut Database) -> Result<usize> {
     }
     write_transaction(db, |tx, columns, p| {
         let n = put_back(tx, columns).sql(p)?;
-        tx.execute_batch("DROP TABLE vgsel_backup; DROP TABLE IF EXISTS vgsel_runs;")
-            .sql(p)?;
+        tx.execute_batch(
+            "DROP TABLE vgsel_backup; DROP TABLE IF EXISTS vgsel_trimmed; \
+             DROP TABLE IF EXISTS vgsel_runs;",
+        )
+        .sql(p)?;
         Ok(n)
     })
 }

@@ -155,7 +155,7 @@ impl Report {
             pairs_verified: plan.pairs.len(),
             pairs_total: plan.graph.edges.len(),
             pairs_selected: selection.pairs.iter().filter(|&&s| s).count(),
-            pairs_invalidated: plan.invalidate.len(),
+            pairs_invalidated: plan.edits.invalidate.len(),
             fitness_floor: plan.fitness_floor,
             pairs_below_fitness_floor: plan.below_fitness_floor,
             graph_before: plan.graph.stats(),

@@ -6,7 +6,7 @@
 
 use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, VerifiedPair};
 use crate::colmap::ids::pair_id;
-use crate::colmap::rewrite;
+use crate::colmap::rewrite::{self, Edits};
 use crate::costs::{self, Costs};
 use crate::flow::connectivity::Biconnected;
 use crate::flow::network::{PairArc, Restriction, SelectionProblem};
@@ -86,8 +86,8 @@ pub struct Plan {
     pub fitness_floor: f64,
     /// Free edges (neither kept nor forbidden) below `fitness_floor`, taken out of the network.
     pub below_fitness_floor: usize,
-    /// pair_ids of the view-graph edges the selection leaves out.
-    pub invalidate: Vec<u64>,
+    /// What the write does: the view-graph edges the selection leaves out are invalidated.
+    pub edits: Edits,
     /// Seconds per stage, for the report.
     pub timings: Timings,
     /// The database's [`Database::data_version`] before anything was read: the write refuses a
@@ -165,7 +165,7 @@ pub fn plan(
     let completion = complete_tracks(&scene, &ruled.network, &mut search, &parameters.flow, stage);
     timings.solve = t.elapsed().as_secs_f64();
 
-    let invalidate = unselected_pair_ids(&graph, &pairs, &search.selection.pairs);
+    let edits = Edits::invalidating(unselected_pair_ids(&graph, &pairs, &search.selection.pairs));
     timings.total = started.elapsed().as_secs_f64();
     Ok(Plan {
         images,
@@ -183,7 +183,7 @@ pub fn plan(
         completion,
         fitness_floor: ruled.fitness_floor,
         below_fitness_floor: ruled.below_fitness_floor,
-        invalidate,
+        edits,
         timings,
         data_version,
     })
