@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use settings::score;
 pub use settings::{CheckSettings, DEFAULT_SETTINGS};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use views::Views;
 
 /// A database pair (verified, not invalidated by a prune) between the two groups.
@@ -389,6 +389,10 @@ pub struct ModelEvidence {
     /// conflict ([`join`]), and the two groups of a model that misplaced one of them
     /// ([`join::place_group`]): what the mapper needs to place them right. Sorted.
     pub links: Vec<[String; 2]>,
+    /// The matches that hold the misplaced images where the model put them
+    /// ([`resection::ImagePlacement::holding`]), per pair in name order: `prune --model` drops
+    /// them from the pairs it keeps. Sorted.
+    pub dropped: Vec<resection::PairMatches>,
 }
 
 /// The check of a mapper's output: each model's (with its misplaced group, if any), and the
@@ -462,7 +466,7 @@ impl RunCheck<'_> {
     /// ghosts' second groups where the matches place them (kept over the blame). Empty
     /// when a repair turn has nothing to act on (the loop's scripts stop there).
     pub fn evidence(&self) -> ModelEvidence {
-        let mut blamed = std::collections::BTreeSet::new();
+        let mut blamed = BTreeSet::new();
         // A ghost that is its misplaced images is theirs: blaming every pair across its split
         // would tear the model (street seed 19: one camera a building off, a split of 16
         // against 28 images at 0.51; its 323 pairs blamed, the next run registered 28 of 44).
@@ -489,7 +493,22 @@ impl RunCheck<'_> {
         for pair in images.clone().flat_map(|m| &m.against) {
             blamed.insert(pair.clone());
         }
-        let mut links = std::collections::BTreeSet::new();
+        // Each pair's matches in name order, merged where both images are misplaced.
+        let mut dropped: BTreeMap<[String; 2], BTreeSet<[u32; 2]>> = BTreeMap::new();
+        for h in images.clone().flat_map(|m| &m.holding) {
+            let [a, b] = h.images.clone();
+            let (key, swap) = if a < b {
+                ([a, b], false)
+            } else {
+                ([b, a], true)
+            };
+            let matches = h
+                .matches
+                .iter()
+                .map(|&[x, y]| if swap { [y, x] } else { [x, y] });
+            dropped.entry(key).or_default().extend(matches);
+        }
+        let mut links = BTreeSet::new();
         for [a, b] in images.flat_map(|m| &m.links).cloned() {
             links.insert(if a < b { [a, b] } else { [b, a] });
         }
@@ -504,6 +523,12 @@ impl RunCheck<'_> {
         ModelEvidence {
             blamed: blamed.into_iter().collect(),
             links: links.into_iter().collect(),
+            dropped: (dropped.into_iter())
+                .map(|(images, m)| resection::PairMatches {
+                    images,
+                    matches: m.into_iter().collect(),
+                })
+                .collect(),
         }
     }
 }

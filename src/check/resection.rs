@@ -37,8 +37,9 @@ pub const MIN_SUPPORT: usize = 30;
 /// another place the image's view repeats, not a correction: on correct models of Cup, Oats
 /// and the symmetric orbit, whose false matches can outnumber an image's true ones, such jumps
 /// of 2.6 to 9.3 spreads reach 1.8 to 4.9 times the model's support. The misplaced images
-/// measured move 0.36 to 1.9 spreads (docs/check.md).
-pub const MAX_MOVED: f64 = 1.5;
+/// measured move 0.36 to 2.41 spreads, the farthest a hall camera put on the other copy's
+/// orbit, 2.36-2.41 in four matchings (docs/check.md, "Held by its own pairs").
+pub const MAX_MOVED: f64 = 2.5;
 /// A pair of a misplaced image is judged (a link or against it) with at least this many
 /// correspondences.
 pub const PAIR_MIN_CORRESPONDENCES: usize = 5;
@@ -66,6 +67,22 @@ pub struct ImagePlacement {
     /// model's pose and more than with the matches': for a misplaced image, they hold it
     /// where the model put it (`prune --model` blames them).
     pub against: Vec<[String; 2]>,
+    /// The matches whose correspondence agrees with the model's pose and not with the
+    /// matches': for a misplaced image, what holds it where the model put it, inside pairs
+    /// that may be true (a hall camera registered 98 degrees off onto an object's repeated
+    /// face by a few dozen such matches among its true pairs' inliers). `prune --model` drops
+    /// them from the pairs it keeps (in the report under `repair`).
+    #[serde(skip)]
+    pub holding: Vec<PairMatches>,
+}
+
+/// Some matches of one pair: each a keypoint of `images[0]` and one of `images[1]`.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+pub struct PairMatches {
+    /// The pair's image names.
+    pub images: [String; 2],
+    /// The matches, sorted.
+    pub matches: Vec<[u32; 2]>,
 }
 
 impl ImagePlacement {
@@ -79,19 +96,42 @@ impl ImagePlacement {
     }
 }
 
-/// View `v`'s correspondences: (keypoint pixel, 3D point index, the view whose keypoint is on
-/// the point). Its own observations first (the view itself): what the model's pose rests on;
+/// One 2D-3D correspondence of a view: its keypoint's pixel on a point of the model.
+struct Correspondence {
+    /// The keypoint's pixel.
+    xy: [f64; 2],
+    /// The 3D point (index into the views' points).
+    point: usize,
+    /// The view whose keypoint is on the point: the view itself for its own observation.
+    view: usize,
+    /// The match behind it (keypoint of this view, of the other), none for an observation.
+    matched: Option<[u32; 2]>,
+}
+
+/// View `v`'s correspondences: its own observations first (what the model's pose rests on);
 /// then each verified match to a keypoint of another view on a point.
-fn correspondences(views: &Views, v: usize) -> Vec<([f64; 2], usize, usize)> {
+fn correspondences(views: &Views, v: usize) -> Vec<Correspondence> {
     let view = &views.views[v];
-    let mut out: Vec<([f64; 2], usize, usize)> = (view.keypoints.iter().zip(&view.point_of))
-        .filter_map(|(xy, p)| p.map(|p| (*xy, p, v)))
+    let mut out: Vec<Correspondence> = (view.keypoints.iter().zip(&view.point_of))
+        .filter_map(|(xy, p)| {
+            p.map(|point| Correspondence {
+                xy: *xy,
+                point,
+                view: v,
+                matched: None,
+            })
+        })
         .collect();
     for w in (0..views.views.len()).filter(|&w| w != v) {
         let (kv, pw) = (&view.keypoints, &views.views[w].point_of);
         for [x, y] in views.pair_matches(v, w) {
             if let (Some(xy), Some(Some(p))) = (kv.get(x as usize), pw.get(y as usize)) {
-                out.push((*xy, *p, w));
+                out.push(Correspondence {
+                    xy: *xy,
+                    point: *p,
+                    view: w,
+                    matched: Some([x, y]),
+                });
             }
         }
     }
@@ -131,25 +171,36 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
     let Some((rotation, translation)) = pnp(views, v, &c)? else {
         return Ok(None);
     };
-    let agrees = |r: &Matrix3<f64>, t: &Vector3<f64>, (xy, p, _): &([f64; 2], usize, usize)| {
+    let agrees = |r: &Matrix3<f64>, t: &Vector3<f64>, k: &Correspondence| {
         view.intrinsics
-            .project(&(r * views.points[*p] + t))
-            .is_some_and(|q| (q[0] - xy[0]).hypot(q[1] - xy[1]) <= AGREE_PX)
+            .project(&(r * views.points[k.point] + t))
+            .is_some_and(|q| (q[0] - k.xy[0]).hypot(q[1] - k.xy[1]) <= AGREE_PX)
     };
     // Per other view: correspondences, those agreeing with the model's pose and those
-    // agreeing with the matches'.
+    // agreeing with the matches'; and the matches agreeing with the model's pose alone.
     let mut pairs: Vec<(usize, [usize; 3])> = Vec::new();
+    let mut holding: Vec<PairMatches> = Vec::new();
     let (mut model_support, mut support) = (0, 0);
     for k in &c {
         let m = usize::from(agrees(&view.rotation, &view.translation, k));
         let s = usize::from(agrees(&rotation, &translation, k));
         (model_support, support) = (model_support + m, support + s);
+        let Some(matched) = k.matched else { continue };
         match pairs.last_mut() {
-            _ if k.2 == v => {}
-            Some(last) if last.0 == k.2 => {
+            Some(last) if last.0 == k.view => {
                 last.1 = [last.1[0] + 1, last.1[1] + m, last.1[2] + s];
             }
-            _ => pairs.push((k.2, [1, m, s])),
+            _ => pairs.push((k.view, [1, m, s])),
+        }
+        if m > s {
+            let images = [view.name.clone(), views.views[k.view].name.clone()];
+            match holding.last_mut() {
+                Some(last) if last.images == images => last.matches.push(matched),
+                _ => holding.push(PairMatches {
+                    images,
+                    matches: vec![matched],
+                }),
+            }
         }
     }
     let moved = (-(rotation.transpose() * translation) - view.centre).norm() / spread;
@@ -170,24 +221,22 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
         moved,
         links: list(&|[n, _, s]| 2 * s >= *n),
         against: list(&|[n, m, s]| 2 * m >= *n && m > s),
+        holding,
     }))
 }
 
 /// The pose of view `v` most correspondences `c` agree with: world-to-camera rotation and
 /// translation, from OpenCV's RANSAC (deterministic: its generator starts from a fixed state).
-fn pnp(views: &Views, v: usize, c: &[([f64; 2], usize, usize)]) -> Result<Option<Pose>> {
+fn pnp(views: &Views, v: usize, c: &[Correspondence]) -> Result<Option<Pose>> {
     let i = &views.views[v].intrinsics;
     let object: Vector<Point3d> = c
         .iter()
-        .map(|(_, p, _)| {
-            let x = views.points[*p];
+        .map(|k| {
+            let x = views.points[k.point];
             Point3d::new(x.x, x.y, x.z)
         })
         .collect();
-    let image: Vector<Point2d> = c
-        .iter()
-        .map(|(xy, _, _)| Point2d::new(xy[0], xy[1]))
-        .collect();
+    let image: Vector<Point2d> = c.iter().map(|k| Point2d::new(k.xy[0], k.xy[1])).collect();
     let camera = Mat::from_slice_2d(&i.camera_matrix())?;
     let coefficients = i.distortion();
     let distortion = Mat::from_slice(&coefficients)?;

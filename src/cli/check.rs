@@ -147,13 +147,15 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         };
         line += &format!(
             "; the database's matches place {} {distance} away ({} of {} correspondences \
-             agree, {} with the model's pose); {} pairs place it back, {} against it",
+             agree, {} with the model's pose); {} pairs place it back, {} against it, {} \
+             matches hold it there",
             m.image,
             m.support,
             m.correspondences,
             m.model_support,
             m.links.len(),
-            m.against.len()
+            m.against.len(),
+            m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
         );
     }
     if !c.unanchored.is_empty() {

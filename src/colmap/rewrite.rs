@@ -206,6 +206,7 @@ fn settle_after_failure(db: &Database) {
         });
 }
 
+/// The prune's write inside `tx`: the original rows back, the edits, the run record.
 fn apply_in<P>(
     tx: &Transaction,
     columns: &[&'static str],
@@ -219,7 +220,39 @@ fn apply_in<P>(
     put_back(tx, columns).sql(p)?;
     tx.execute_batch("DELETE FROM vgsel_backup; DELETE FROM vgsel_trimmed;")
         .sql(p)?;
+    write_edits(tx, columns, p, edits)?;
+    let count = |n: usize| n as i64;
+    tx.execute(
+        "INSERT INTO vgsel_runs (time, tool_version, parameters, flow, images_total, \
+         images_selected, pairs_total, pairs_selected, user_version) \
+         VALUES (strftime('%Y-%m-%dT%H:%M:%SZ', 'now'), ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
+        rusqlite::params![
+            env!("CARGO_PKG_VERSION"),
+            parameters,
+            run.flow.map(|f| f as i64),
+            count(run.images_total),
+            count(run.images_selected),
+            count(run.pairs_total),
+            count(run.pairs_selected),
+            schema::user_version(tx).sql(p)?,
+        ],
+    )
+    .sql(p)?;
+    Ok(())
+}
 
+/// Backs up and edits each pair of `edits` (from the original rows): invalidated ones
+/// cleared, trimmed ones given their kept inliers and listed in `vgsel_trimmed`. Refuses a
+/// pair edited twice or without a row.
+fn write_edits(tx: &Transaction, columns: &[&'static str], p: &Path, edits: &Edits) -> Result<()> {
+    let unique: BTreeSet<u64> = edits.invalidate.iter().copied().collect();
+    let mut trims = BTreeSet::new();
+    if let Some(t) =
+        (edits.trim.iter()).find(|t| unique.contains(&t.pair_id) || !trims.insert(t.pair_id))
+    {
+        let (a, b) = image_ids(t.pair_id);
+        bail!("pair_id {} (images {a}, {b}) is edited twice (trimmed and invalidated, or trimmed twice)", t.pair_id);
+    }
     let copied: Vec<&str> = TWO_VIEW_COLUMNS
         .iter()
         .map(|c| if columns.contains(c) { *c } else { "NULL" })
@@ -253,14 +286,6 @@ fn apply_in<P>(
     let mut trimmed = tx
         .prepare("INSERT INTO vgsel_trimmed (pair_id) VALUES (?1)")
         .sql(p)?;
-    let unique: BTreeSet<u64> = edits.invalidate.iter().copied().collect();
-    let mut trims = BTreeSet::new();
-    if let Some(t) =
-        (edits.trim.iter()).find(|t| unique.contains(&t.pair_id) || !trims.insert(t.pair_id))
-    {
-        let (a, b) = image_ids(t.pair_id);
-        bail!("pair_id {} (images {a}, {b}) is edited twice (trimmed and invalidated, or trimmed twice)", t.pair_id);
-    }
     let mut back_up = |id: u64, what: &str| -> Result<i64> {
         let (a, b) = image_ids(id);
         let raw = i64::try_from(id).map_err(|_| anyhow!("pair_id {id} out of range"))?;
@@ -281,25 +306,6 @@ fn apply_in<P>(
             .sql(p)?;
         trimmed.execute([raw]).sql(p)?;
     }
-    drop((backup, clear, trim, trimmed));
-
-    let count = |n: usize| n as i64;
-    tx.execute(
-        "INSERT INTO vgsel_runs (time, tool_version, parameters, flow, images_total, \
-         images_selected, pairs_total, pairs_selected, user_version) \
-         VALUES (strftime('%Y-%m-%dT%H:%M:%SZ', 'now'), ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
-        rusqlite::params![
-            env!("CARGO_PKG_VERSION"),
-            parameters,
-            run.flow.map(|f| f as i64),
-            count(run.images_total),
-            count(run.images_selected),
-            count(run.pairs_total),
-            count(run.pairs_selected),
-            schema::user_version(tx).sql(p)?,
-        ],
-    )
-    .sql(p)?;
     Ok(())
 }
 

@@ -1,5 +1,6 @@
 //! What a prune did: the JSON report (`--report FILE`) and the short summary on stderr.
 
+use crate::colmap::ids::pair_id;
 use crate::flow::search::CriterionStatus;
 use crate::named::Named;
 use crate::priors::PriorValues;
@@ -49,6 +50,11 @@ pub struct Report {
     pub pairs_selected: usize,
     /// Edges invalidated (or that would be, on a dry run): `pairs_total - pairs_selected`.
     pub pairs_invalidated: usize,
+    /// Selected edges kept with fewer inliers: `--model` dropped the matches that held a
+    /// misplaced image where a mapper put it.
+    pub pairs_trimmed: usize,
+    /// The inliers those pairs lost.
+    pub matches_dropped: usize,
     /// The fitness floor applied: the cost model's `min_pair_fitness`, lowered (with a
     /// searched flow) until the image criterion's number of images keep a pair reaching it.
     pub fitness_floor: f64,
@@ -156,6 +162,8 @@ impl Report {
             pairs_total: plan.graph.edges.len(),
             pairs_selected: selection.pairs.iter().filter(|&&s| s).count(),
             pairs_invalidated: plan.edits.invalidate.len(),
+            pairs_trimmed: plan.edits.trim.len(),
+            matches_dropped: matches_dropped(plan),
             fitness_floor: plan.fitness_floor,
             pairs_below_fitness_floor: plan.below_fitness_floor,
             graph_before: plan.graph.stats(),
@@ -265,6 +273,12 @@ impl Report {
                 links.len()
             );
         }
+        if self.pairs_trimmed > 0 {
+            s += &format!(
+                "\nmodel check: {} matches that held misplaced images dropped from {} kept pairs",
+                self.matches_dropped, self.pairs_trimmed
+            );
+        }
         if self.order.keep_neighbours > 0 {
             s += &format!(
                 "\nclose neighbours: {} pairs within {} positions kept",
@@ -284,6 +298,20 @@ impl Report {
 /// Mean of the values that are numbers: a NaN fitness means the prior does not apply to that item
 /// (no triangle, no second motion), and the cost leaves it out too. No items: 0; items but none
 /// the prior applies to: NaN (null in the JSON).
+/// The inliers the trimmed pairs lost.
+fn matches_dropped(plan: &Plan) -> usize {
+    let before = |id: u64| {
+        let p = plan
+            .pairs
+            .iter()
+            .find(|p| pair_id(p.image_id1, p.image_id2) == id);
+        p.map_or(0, |p| p.inliers.len())
+    };
+    (plan.edits.trim.iter())
+        .map(|t| before(t.pair_id) - t.inliers.len())
+        .sum()
+}
+
 /// Names of the images without a view-graph edge, sorted.
 fn isolated_names(plan: &Plan) -> Vec<String> {
     let names: HashMap<u32, &str> = plan

@@ -20,6 +20,7 @@
 //! --match_type pairs` reads them; one image name per line for images); blank lines and lines
 //! starting with `#` are skipped.
 
+use crate::check::resection::PairMatches;
 use crate::colmap::database::Image;
 use crate::flow::network::ArcRule;
 use crate::flow::search::FlowRule;
@@ -27,7 +28,7 @@ use crate::scene::view_graph::ViewGraph;
 use crate::selection::capture_order::CaptureOrder;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The arc rules a prune was asked for (part of [`crate::selection::parameters::Parameters`]).
@@ -111,6 +112,9 @@ pub struct ModelFolder {
     pub blamed: NameList,
     /// The pairs that link its clean models: kept.
     pub links: NameList,
+    /// The matches that held its misplaced images where the mapper put them: dropped from
+    /// the pairs kept.
+    pub dropped: Vec<PairMatches>,
 }
 
 /// The overrides as listed in the report, by image name.
@@ -144,6 +148,9 @@ pub struct Resolved {
     pub forbidden_vertices: Vec<bool>,
     /// What was resolved, by name, for the report.
     pub listed: Listed,
+    /// Per edge, the matches `--model` drops from the pair if it is kept, as the pair's
+    /// inliers hold them (keypoint of its first image_id first).
+    pub dropped: BTreeMap<usize, BTreeSet<[u32; 2]>>,
 }
 
 impl Overrides {
@@ -161,6 +168,7 @@ impl Overrides {
             edges: vec![ArcRule::Free; graph.edges.len()],
             forbidden_vertices: vec![false; graph.num_vertices()],
             listed: Listed::default(),
+            dropped: BTreeMap::new(),
         };
         if !self.model.is_empty() {
             resolved.apply_model_evidence(&self.model, &names)?;
@@ -294,6 +302,32 @@ impl Resolved {
         let [(blamed, _), (linked, _)] = listed;
         self.listed.model_conflicts = Some(blamed);
         self.listed.model_links = Some(linked);
+        for (folder, pair) in folders
+            .iter()
+            .flat_map(|f| f.dropped.iter().map(move |p| (f, p)))
+        {
+            let id = |name: &str| {
+                let id = names.ids.get(name).copied();
+                id.with_context(|| {
+                    format!(
+                        "--model {}: no image named `{name}` in the database",
+                        folder.links.path.display()
+                    )
+                })
+            };
+            let (a, b) = (id(&pair.images[0])?, id(&pair.images[1])?);
+            let edge = match (names.vertex(a), names.vertex(b)) {
+                (Some(x), Some(y)) => names.edge_index.get(&(x.min(y), x.max(y))).copied(),
+                _ => None,
+            };
+            if let Some(k) = edge {
+                let oriented = pair
+                    .matches
+                    .iter()
+                    .map(|&[x, y]| if a < b { [x, y] } else { [y, x] });
+                self.dropped.entry(k).or_default().extend(oriented);
+            }
+        }
         Ok(())
     }
 
@@ -424,7 +458,48 @@ mod tests {
         ModelFolder {
             blamed: list(path, blamed),
             links: list(path, links),
+            dropped: Vec::new(),
         }
+    }
+
+    /// The matches folders drop are resolved per edge, turned to the pair's stored order (the
+    /// first image_id's keypoint first) and merged; a pair that is no edge drops nothing; an
+    /// unknown image is an error naming the folder.
+    #[test]
+    fn matches_the_model_check_drops_are_resolved_per_edge_in_the_pairs_order() {
+        let (images, graph) = four_in_a_row();
+        let name = |id: u32| images[id as usize - 1].name.clone();
+        let drop = |a: u32, b: u32, matches: Vec<[u32; 2]>| PairMatches {
+            images: [name(a), name(b)],
+            matches,
+        };
+        let mut first = folder("sparse", vec![], vec![]);
+        first.dropped = vec![drop(3, 2, vec![[7, 1]]), drop(1, 4, vec![[1, 1]])];
+        let mut second = folder("sparse2", vec![], vec![]);
+        second.dropped = vec![drop(2, 3, vec![[2, 8], [1, 7]])];
+        let overrides = Overrides {
+            model: vec![first, second],
+            ..Overrides::default()
+        };
+        let resolved = overrides.resolve(&images, &graph, 15).unwrap();
+        let want: BTreeMap<usize, BTreeSet<[u32; 2]>> =
+            [(1, [[1, 7], [2, 8]].into_iter().collect())].into();
+        assert_eq!(resolved.dropped, want);
+        assert_eq!(resolved.edges, [ArcRule::Free; 3]);
+        let mut unknown = folder("sparse3", vec![], vec![]);
+        unknown.dropped = vec![PairMatches {
+            images: ["nope.png".into(), name(1)],
+            matches: vec![[0, 0]],
+        }];
+        let overrides = Overrides {
+            model: vec![unknown],
+            ..Overrides::default()
+        };
+        let e = overrides.resolve(&images, &graph, 15).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--model sparse3: no image named `nope.png` in the database"
+        );
     }
 
     /// The model check's pairs leave the network like forbidden pairs, and are listed once

@@ -210,6 +210,7 @@ impl Parameters {
                 model.push(ModelFolder {
                     blamed: list(found.blamed),
                     links: list(found.links),
+                    dropped: found.dropped,
                 });
             }
         }

@@ -6,7 +6,7 @@
 
 use crate::colmap::database::{Camera, Database, Image, TwoViewGeometry, VerifiedPair};
 use crate::colmap::ids::pair_id;
-use crate::colmap::rewrite::{self, Edits};
+use crate::colmap::rewrite::{self, Edits, Trim};
 use crate::costs::{self, Costs};
 use crate::flow::connectivity::Biconnected;
 use crate::flow::network::{PairArc, Restriction, SelectionProblem};
@@ -23,7 +23,7 @@ use crate::selection::preset::Preset;
 use crate::selection::track_completion::{self, Completion};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::time::Instant;
 
 /// What the outputs want of a plan beyond the selection.
@@ -165,7 +165,9 @@ pub fn plan(
     let completion = complete_tracks(&scene, &ruled.network, &mut search, &parameters.flow, stage);
     timings.solve = t.elapsed().as_secs_f64();
 
-    let edits = Edits::invalidating(unselected_pair_ids(&graph, &pairs, &search.selection.pairs));
+    // 7. The edits: pairs left out invalidated, kept ones trimmed of what `--model` drops.
+    let kept = &search.selection.pairs;
+    let edits = edits(&graph, &pairs, kept, &rules.dropped);
     timings.total = started.elapsed().as_secs_f64();
     Ok(Plan {
         images,
@@ -290,15 +292,33 @@ fn apply_arc_rules(
     }
 }
 
-/// The pair_ids of the view-graph edges the selection leaves out: what the rewrite invalidates.
-fn unselected_pair_ids(graph: &ViewGraph, pairs: &[VerifiedPair], kept: &[bool]) -> Vec<u64> {
-    graph
-        .edges
-        .iter()
-        .zip(kept)
-        .filter(|(_, &kept)| !kept)
-        .map(|(e, _)| pair_id(pairs[e.pair].image_id1, pairs[e.pair].image_id2))
-        .collect()
+/// Stage 7: what the write does. The view-graph edges the selection leaves out are
+/// invalidated; a kept pair with matches `--model` drops is trimmed to the rest of its inliers
+/// (below `--min_num_matches` the mapper passes it over, as any pair that weak).
+fn edits(
+    graph: &ViewGraph,
+    pairs: &[VerifiedPair],
+    kept: &[bool],
+    dropped: &BTreeMap<usize, BTreeSet<[u32; 2]>>,
+) -> Edits {
+    let mut edits = Edits::default();
+    for (k, (e, &kept)) in graph.edges.iter().zip(kept).enumerate() {
+        let pair = &pairs[e.pair];
+        let id = pair_id(pair.image_id1, pair.image_id2);
+        let trimmed: Option<Vec<[u32; 2]>> = dropped.get(&k).filter(|_| kept).map(|d| {
+            let left = pair.inliers.iter().filter(|m| !d.contains(*m));
+            left.copied().collect()
+        });
+        match trimmed {
+            _ if !kept => edits.invalidate.push(id),
+            Some(inliers) if inliers.len() < pair.inliers.len() => edits.trim.push(Trim {
+                pair_id: id,
+                inliers,
+            }),
+            _ => {}
+        }
+    }
+    edits
 }
 
 /// Stage 5: the flow search on the network, its selection mapped back to the whole view graph
@@ -489,5 +509,50 @@ mod tests {
         assert_eq!(skipped(vec![0, 1, 2]), [(1, 3)]);
         assert_eq!(skipped(vec![0, 2, 1]), [(1, 2)]);
         assert_eq!(skipped(vec![1, 0, 2]), [(2, 3)]);
+    }
+
+    /// A pair left out is invalidated whatever `--model` drops; a kept one is trimmed to the
+    /// inliers not dropped (their order kept), however few are left; a kept pair with none of
+    /// its inliers dropped is not touched.
+    #[test]
+    fn kept_pairs_are_trimmed_of_the_dropped_matches() {
+        let images = images(4);
+        let inliers: Vec<[u32; 2]> = (0..20).map(|k| [k, 100 + k]).collect();
+        let pairs: Vec<VerifiedPair> = [(1, 2), (2, 3), (3, 4), (1, 4)]
+            .map(|(a, b)| pair(a, b, inliers.clone()))
+            .to_vec();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let edge = |a: u32, b: u32| {
+            let e = graph.edges.iter().position(|e| {
+                let ids = |x: u32| graph.image_ids[x as usize];
+                (ids(e.i), ids(e.j)) == (a, b)
+            });
+            e.unwrap()
+        };
+        let dropped: BTreeMap<usize, BTreeSet<[u32; 2]>> = [
+            (edge(1, 2), [[3, 103], [5, 105], [5, 999]].into()),
+            (edge(2, 3), inliers[..6].iter().copied().collect()),
+            (edge(1, 4), [[0, 100]].into()),
+        ]
+        .into();
+        let mut kept = vec![true; 4];
+        kept[edge(1, 4)] = false;
+        let e = edits(&graph, &pairs, &kept, &dropped);
+        let id = |a, b| pair_id(a, b);
+        assert_eq!(e.invalidate, [id(1, 4)]);
+        let left = |gone: &dyn Fn(u32) -> bool| -> Vec<[u32; 2]> {
+            inliers.iter().filter(|m| !gone(m[0])).copied().collect()
+        };
+        let trim = |a, b, inliers| Trim {
+            pair_id: id(a, b),
+            inliers,
+        };
+        assert_eq!(
+            e.trim,
+            [
+                trim(1, 2, left(&|k| k == 3 || k == 5)),
+                trim(2, 3, left(&|k| k < 6))
+            ]
+        );
     }
 }
