@@ -60,9 +60,11 @@ pub struct PruneArgs {
     #[arg(long, value_name = "FILE", help_heading = SELECT)]
     forbid_images: Option<PathBuf>,
     /// A mapper's output on this database (a model folder or its output_path), for the repair
-    /// loop: the pairs that glued a model `check` finds ghosted are never selected, and the
-    /// pairs that link clean models `check` joins are kept (docs/check.md). Repeat it with every
-    /// earlier turn's output, in order, so that no turn selects again what an earlier one blamed.
+    /// loop: the pairs that glued a model `check` finds ghosted are never selected, the pairs
+    /// that link clean models `check` joins or place a misplaced image back are kept, and the
+    /// matches that held a misplaced image are dropped from the pairs kept (docs/check.md).
+    /// Repeat it with every earlier turn's output, in order, so that no turn selects again what
+    /// an earlier one blamed.
     #[arg(long, value_name = "DIR", help_heading = SELECT)]
     model: Vec<PathBuf>,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
