@@ -373,4 +373,18 @@ fn the_repair_loop_makes_one_correct_model_of_the_halls_two_orbits() {
     }
     assert_eq!(last["models"], 1, "{checks:?}");
     assert_eq!(last["correct"], 38, "{checks:?}");
+    // Each turn's database is the full one with its edits (pairs invalidated, kept pairs
+    // trimmed of the matches that held a misplaced image): restored, it is the full one again,
+    // byte for byte.
+    let full = crate::support::dump(&work.join("full.db"), "two_view_geometries");
+    for k in 1..=turns {
+        let db = work.join(format!("repaired{k}.db"));
+        let out = vgsel(&["restore", "--database_path", db.to_str().unwrap()]);
+        assert!(out.status.success(), "{out:?}");
+        assert_eq!(
+            crate::support::dump(&db, "two_view_geometries"),
+            full,
+            "turn {k}"
+        );
+    }
 }
