@@ -63,7 +63,7 @@ fn check_exit_statuses_report_and_plots() {
     assert_eq!(value["models"][0]["ghost_placement"], Value::Null);
     assert_eq!(
         value["repair"],
-        serde_json::json!({ "blamed": [], "links": [] })
+        serde_json::json!({ "blamed": [], "dropped": [], "links": [] })
     );
     assert_eq!(value["models"][0]["images"], 2);
     assert!(plots.join("top_view_0.svg").is_file());
