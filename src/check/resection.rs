@@ -181,29 +181,20 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
     };
     // Per other view: correspondences, those agreeing with the model's pose and those
     // agreeing with the matches'; and the matches agreeing with the model's pose alone.
-    let mut pairs: Vec<(usize, [usize; 3])> = Vec::new();
-    let mut holding: Vec<PairMatches> = Vec::new();
+    let mut pairs: Vec<(usize, [usize; 3], Vec<[u32; 2]>)> = Vec::new();
     let (mut model_support, mut support) = (0, 0);
     for k in &c {
         let m = usize::from(agrees(&view.rotation, &view.translation, k));
         let s = usize::from(agrees(&rotation, &translation, k));
         (model_support, support) = (model_support + m, support + s);
         let Some(matched) = k.matched else { continue };
-        match pairs.last_mut() {
-            Some(last) if last.0 == k.view => {
-                last.1 = [last.1[0] + 1, last.1[1] + m, last.1[2] + s];
-            }
-            _ => pairs.push((k.view, [1, m, s])),
+        if pairs.last().is_none_or(|last| last.0 != k.view) {
+            pairs.push((k.view, [0; 3], Vec::new()));
         }
+        let last = pairs.last_mut().expect("pushed above");
+        last.1 = [last.1[0] + 1, last.1[1] + m, last.1[2] + s];
         if m > s {
-            let images = [view.name.clone(), views.views[k.view].name.clone()];
-            match holding.last_mut() {
-                Some(last) if last.images == images => last.matches.push(matched),
-                _ => holding.push(PairMatches {
-                    images,
-                    matches: vec![matched],
-                }),
-            }
+            last.2.push(matched);
         }
     }
     let moved = (-(rotation.transpose() * translation) - view.centre).norm() / spread;
@@ -216,14 +207,23 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
             .map(|p| named(p.0))
             .collect()
     };
+    let links = list(&|[n, m, s]| 2 * s >= *n && s >= m);
+    let against = list(&|[n, m, s]| 2 * m >= *n && m > s);
+    let holding = (pairs.into_iter())
+        .filter(|p| !p.2.is_empty())
+        .map(|(w, _, matches)| PairMatches {
+            images: named(w),
+            matches,
+        })
+        .collect();
     Ok(Some(ImagePlacement {
         image: view.name.clone(),
         correspondences: c.len(),
         model_support,
         support,
         moved,
-        links: list(&|[n, m, s]| 2 * s >= *n && s >= m),
-        against: list(&|[n, m, s]| 2 * m >= *n && m > s),
+        links,
+        against,
         holding,
     }))
 }

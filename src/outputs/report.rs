@@ -295,9 +295,6 @@ impl Report {
     }
 }
 
-/// Mean of the values that are numbers: a NaN fitness means the prior does not apply to that item
-/// (no triangle, no second motion), and the cost leaves it out too. No items: 0; items but none
-/// the prior applies to: NaN (null in the JSON).
 /// The inliers the trimmed pairs lost.
 fn matches_dropped(plan: &Plan) -> usize {
     let before = |id: u64| {
@@ -378,6 +375,9 @@ impl OrderReport {
     }
 }
 
+/// Mean of the values that are numbers: a NaN fitness means the prior does not apply to that item
+/// (no triangle, no second motion), and the cost leaves it out too. No items: 0; items but none
+/// the prior applies to: NaN (null in the JSON).
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
     let (mut sum, mut n, mut items) = (0.0, 0usize, 0usize);
     for v in values {

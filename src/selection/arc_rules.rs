@@ -236,10 +236,15 @@ impl<'a> Names<'a> {
                 names[0]
             );
         }
-        Ok(match (self.vertex(a), self.vertex(b)) {
+        Ok(self.edge_between(a, b))
+    }
+
+    /// The edge between images `a` and `b` (image_ids), or None when it is no view-graph edge.
+    fn edge_between(&self, a: u32, b: u32) -> Option<usize> {
+        match (self.vertex(a), self.vertex(b)) {
             (Some(x), Some(y)) => self.edge_index.get(&(x.min(y), x.max(y))).copied(),
             _ => None,
-        })
+        }
     }
 }
 
@@ -316,11 +321,7 @@ impl Resolved {
                 })
             };
             let (a, b) = (id(&pair.images[0])?, id(&pair.images[1])?);
-            let edge = match (names.vertex(a), names.vertex(b)) {
-                (Some(x), Some(y)) => names.edge_index.get(&(x.min(y), x.max(y))).copied(),
-                _ => None,
-            };
-            if let Some(k) = edge {
+            if let Some(k) = names.edge_between(a, b) {
                 let oriented = pair
                     .matches
                     .iter()

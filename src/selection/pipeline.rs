@@ -305,17 +305,19 @@ fn edits(
     for (k, (e, &kept)) in graph.edges.iter().zip(kept).enumerate() {
         let pair = &pairs[e.pair];
         let id = pair_id(pair.image_id1, pair.image_id2);
-        let trimmed: Option<Vec<[u32; 2]>> = dropped.get(&k).filter(|_| kept).map(|d| {
-            let left = pair.inliers.iter().filter(|m| !d.contains(*m));
-            left.copied().collect()
-        });
-        match trimmed {
-            _ if !kept => edits.invalidate.push(id),
-            Some(inliers) if inliers.len() < pair.inliers.len() => edits.trim.push(Trim {
-                pair_id: id,
-                inliers,
-            }),
-            _ => {}
+        if !kept {
+            edits.invalidate.push(id);
+        } else if let Some(d) = dropped.get(&k) {
+            let inliers: Vec<[u32; 2]> = (pair.inliers.iter())
+                .filter(|m| !d.contains(*m))
+                .copied()
+                .collect();
+            if inliers.len() < pair.inliers.len() {
+                edits.trim.push(Trim {
+                    pair_id: id,
+                    inliers,
+                });
+            }
         }
     }
     edits
