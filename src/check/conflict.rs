@@ -39,7 +39,8 @@ pub struct Counts {
     pub agreeing: usize,
     /// Of the agreeing, those only the database's matches showed.
     pub matched: usize,
-    /// Samples where the image saw the point itself.
+    /// Points both sides saw: the structure they share, not judged (for one image alone, see
+    /// [`count_alone`]).
     pub seen: usize,
 }
 
@@ -163,12 +164,17 @@ pub(super) fn within_gates(
         && scale * settings.max_scale >= 1.0
 }
 
-/// The conflicts of the split `side` (true: group B) in both directions.
+/// The conflicts of the split `side` (true: group B) in both directions, judged on the points
+/// one group alone saw (Heinly et al.'s unique structure). A point both groups saw is what they
+/// share: the duplicate structure that glued two copies, or the overlap of a correct model. It
+/// agrees wherever it projects, and in a street of identical facades in front of a unique wall
+/// that agreement outweighed the wall's conflicts (a block of 15 cameras two buildings off:
+/// 0.45 with shared points, 0.64 without; correct streets' worst splits went down as well).
 pub fn count(views: &Views, reach: &Reach, side: &[bool], settings: &ConflictSettings) -> Counts {
     let member = membership(views, side);
     let mut counts = Counts::default();
-    // A point counts only where it reaches both groups (observed in one, observed or judged
-    // in the other): every such point is among those the smaller group reaches.
+    // A point counts only where it reaches both groups (observed in one, judged in the other):
+    // every such point is among those the smaller group reaches.
     let smaller = usize::from(side.iter().filter(|&&s| s).count() * 2 <= side.len());
     let mut visited = vec![false; views.points.len()];
     let reached = (0..side.len())
@@ -178,19 +184,18 @@ pub fn count(views: &Views, reach: &Reach, side: &[bool], settings: &ConflictSet
         if std::mem::replace(&mut visited[k], true) {
             continue;
         }
-        let track = &views.observers[k];
-        // Only points the other group saw.
-        let other = |b: usize| member[k][1 - usize::from(side[b])];
-        counts.seen += track.iter().filter(|&&b| other(b)).count();
-        for &b in reach.of(k).iter().filter(|&&b| other(b)) {
-            let group = usize::from(side[b]);
-            let from: Vec<(usize, u32)> = track
-                .iter()
-                .copied()
-                .zip(views.observed_at[k].iter().copied())
-                .filter(|&(a, _)| usize::from(side[a]) != group)
-                .collect();
-            let ours = |j: usize| member[j][1 - group];
+        let owner = match member[k] {
+            [true, true] => {
+                counts.seen += 1;
+                continue;
+            }
+            [_, owner] => owner,
+        };
+        let from: Vec<(usize, u32)> = (views.observers[k].iter().copied())
+            .zip(views.observed_at[k].iter().copied())
+            .collect();
+        let ours = |j: usize| member[j][usize::from(owner)];
+        for &b in reach.of(k).iter().filter(|&&b| side[b] != owner) {
             counts.add(judge(views, k, b, &from, &ours, settings));
         }
     }
@@ -213,17 +218,16 @@ pub fn count_model(
 
 /// [`count`] of the split that puts view `b` alone in one group, in one pass over the points
 /// `b` saw or could judge: what `b` saw, judged in every other view; what the others saw and
-/// `b` did not, judged in `b`.
+/// `b` did not, judged in `b`. Unlike [`count`], the points `b` shares with others are judged:
+/// one image has no structure of its own (every point it observes has other observers), and a
+/// camera on the wrong copy shows in where its points fall in the views that missed them.
 pub fn count_alone(views: &Views, reach: &Reach, b: usize, settings: &ConflictSettings) -> Counts {
     let mut counts = Counts::default();
     for &k in &reach.points[b] {
         let track = &views.observers[k];
         match track.binary_search(&b) {
             Ok(at) => {
-                if track.len() > 1 {
-                    // Seen by b and by others: seen in b, and in each other observer.
-                    counts.seen += track.len();
-                }
+                counts.seen += usize::from(track.len() > 1);
                 let from = [(b, views.observed_at[k][at])];
                 let ours = |j: usize| views.observers[j].binary_search(&b).is_ok();
                 for &v in reach.of(k) {
@@ -245,7 +249,7 @@ pub fn count_alone(views: &Views, reach: &Reach, b: usize, settings: &ConflictSe
 }
 
 /// How a sample ended.
-enum Sample {
+pub(super) enum Sample {
     /// Only the image's own group's structure near the projection.
     Conflicting,
     /// Structure both groups saw near the projection.
@@ -255,7 +259,7 @@ enum Sample {
 }
 
 impl Counts {
-    fn add(&mut self, sample: Option<Sample>) {
+    pub(super) fn add(&mut self, sample: Option<Sample>) {
         match sample {
             Some(Sample::Conflicting) => self.conflicting += 1,
             Some(Sample::Agreeing) => self.agreeing += 1,
@@ -271,7 +275,7 @@ impl Counts {
 /// How one sample ends: `None` when not judged (behind, outside, too oblique or far off in
 /// scale, nothing near). `from` are the projecting side's observations of point `k` (view,
 /// keypoint); `ours(j)` says whether point `j` belongs to the projecting side.
-fn judge(
+pub(super) fn judge(
     views: &Views,
     k: usize,
     b: usize,
@@ -317,7 +321,8 @@ pub fn pair_counts(views: &Views, a: usize, b: usize, settings: &ConflictSetting
         let ours = |j: usize| views.observers[j].binary_search(&from).is_ok();
         for &k in &views.seen_by[from] {
             if views.observers[k].binary_search(&to).is_ok() {
-                counts.seen += 1;
+                // Once, from the first image's side.
+                counts.seen += usize::from(from == a);
                 continue;
             }
             let Ok(at) = views.observers[k].binary_search(&from) else {

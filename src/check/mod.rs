@@ -85,10 +85,13 @@ pub struct ModelCheck<'e> {
     pub ghosted: bool,
     /// The worst split's score (0 without a split).
     pub score: f64,
-    /// The worst split, if the model could be split at all.
+    /// The worst split, if the model could be split at all; for a clean model whose group at
+    /// the co-visibility tree's weakest link the database places elsewhere (and none at the
+    /// worst split), that split.
     pub worst: Option<Split>,
-    /// With the database: the worst split of a clean model whose second group the database's
-    /// matches place elsewhere than the model does ([`join::place_group`]). The model is wrong.
+    /// With the database: the placement of a clean model's split (`worst`) whose second group
+    /// the database's matches place elsewhere than the model does ([`join::place_group`]). The
+    /// model is wrong.
     pub misplaced: Option<join::Join>,
     /// With the database, for a ghosted model: where its matches place the worst split's
     /// second group once the model's own placement is refuted ([`join::place_group`]);
@@ -109,6 +112,12 @@ pub struct ModelCheck<'e> {
     /// Which group each image is in (0 or 1) for the worst split, by image name.
     #[serde(skip)]
     pub side: Vec<bool>,
+    /// With the database, for a clean model: the split at the co-visibility tree's weakest
+    /// link ([`splits::weakest_link_split`]) where it is not the worst, the other place a
+    /// misplaced group is looked for. Points both groups saw are not judged, so a group carried
+    /// off whole conflicts with nothing and its split need not be the worst.
+    #[serde(skip)]
+    pub weakest_link: Option<(Vec<bool>, Split)>,
     /// The views (for plots).
     #[serde(skip)]
     pub views: Option<Views<'e>>,
@@ -188,10 +197,20 @@ pub fn check_model<'e>(
         }
         None => (vec![false; n], None),
     };
-    let score = split.as_ref().map_or(0.0, |s| s.score);
     let ghosted = split
         .as_ref()
         .is_some_and(|s| is_ghost(&s.counts, settings));
+    let weakest_link = (evidence.is_some() && !ghosted)
+        .then(|| splits::weakest_link_split(n, &covisibility.links(), settings.min_group))
+        .flatten()
+        .filter(|weakest| *weakest != side)
+        .map(|weakest| {
+            let counts = conflict::count(&views, &reach, &weakest, &settings.conflict);
+            let mut split = describe(&views, &covisibility, &weakest, counts, pairs);
+            split.score = score(&counts, settings);
+            (weakest, split)
+        });
+    let score = split.as_ref().map_or(0.0, |s| s.score);
     Ok(ModelCheck {
         images: n,
         points: views.points.len(),
@@ -205,6 +224,7 @@ pub fn check_model<'e>(
         ghost_of_images: false,
         unanchored: unanchored(&views),
         side,
+        weakest_link,
         views: Some(views),
     })
 }
@@ -273,11 +293,7 @@ fn candidates(
     settings: &CheckSettings,
 ) -> splits::SplitList {
     let n = views.views.len();
-    let links: Vec<(f64, usize, usize)> = covisibility
-        .shared
-        .keys()
-        .map(|&(a, b)| (covisibility.strength(a, b), a, b))
-        .collect();
+    let links = covisibility.links();
     let pairs: Vec<Counts> = links
         .par_iter()
         .map(|&(_, a, b)| conflict::pair_counts(views, a, b, &settings.conflict))
@@ -420,7 +436,13 @@ pub fn check_run<'e>(
             for (k, (model, c)) in models.iter().zip(&mut checks).enumerate() {
                 let Some(worst) = &c.worst else { continue };
                 let groups = worst.groups.clone();
-                let placed = join::place_group(k, model, &groups, e, settings, c.ghosted)?;
+                let mut placed = join::place_group(k, model, &groups, e, settings, c.ghosted)?;
+                if let (None, Some((side, split))) = (&placed, c.weakest_link.take()) {
+                    placed = join::place_group(k, model, &split.groups, e, settings, false)?;
+                    if placed.is_some() {
+                        (c.side, c.worst) = (side, Some(split));
+                    }
+                }
                 if c.ghosted {
                     c.ghost_placement = placed;
                 } else {

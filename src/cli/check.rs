@@ -323,6 +323,7 @@ mod tests {
             ghost_of_images: false,
             unanchored: Vec::new(),
             side: Vec::new(),
+            weakest_link: None,
             views: None,
         }
     }
