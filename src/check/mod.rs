@@ -201,15 +201,8 @@ pub fn check_model<'e>(
         .as_ref()
         .is_some_and(|s| is_ghost(&s.counts, settings));
     let weakest_link = (evidence.is_some() && !ghosted)
-        .then(|| splits::weakest_link_split(n, &covisibility.links(), settings.min_group))
-        .flatten()
-        .filter(|weakest| *weakest != side)
-        .map(|weakest| {
-            let counts = conflict::count(&views, &reach, &weakest, &settings.conflict);
-            let mut split = describe(&views, &covisibility, &weakest, counts, pairs);
-            split.score = score(&counts, settings);
-            (weakest, split)
-        });
+        .then(|| weakest_link(&views, &covisibility, &reach, &side, pairs, settings))
+        .flatten();
     let score = split.as_ref().map_or(0.0, |s| s.score);
     Ok(ModelCheck {
         images: n,
@@ -226,6 +219,26 @@ pub fn check_model<'e>(
         side,
         weakest_link,
         views: Some(views),
+    })
+}
+
+/// The split at the co-visibility tree's weakest link ([`splits::weakest_link_split`]), scored
+/// and described (`pairs`: the database's, as for the worst), unless it is `worst`.
+fn weakest_link(
+    views: &Views,
+    covisibility: &splits::Covisibility,
+    reach: &conflict::Reach,
+    worst: &[bool],
+    pairs: Option<&BTreeMap<(String, String), usize>>,
+    settings: &CheckSettings,
+) -> Option<(Vec<bool>, Split)> {
+    let n = views.views.len();
+    let side = splits::weakest_link_split(n, &covisibility.links(), settings.min_group)?;
+    (side != worst).then(|| {
+        let counts = conflict::count(views, reach, &side, &settings.conflict);
+        let mut split = describe(views, covisibility, &side, counts, pairs);
+        split.score = score(&counts, settings);
+        (side, split)
     })
 }
 
