@@ -63,16 +63,16 @@ impl Sets {
 }
 
 /// The maximum spanning forest of a graph given as (weight, view, view) edges (Kruskal, ties
-/// by view indices).
-pub fn spanning_tree(n: usize, mut edges: Vec<(f64, usize, usize)>) -> Vec<(usize, usize)> {
+/// by view indices): the edges it keeps, as given.
+pub fn spanning_tree(n: usize, mut edges: Vec<(f64, usize, usize)>) -> Vec<(f64, usize, usize)> {
     edges.sort_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
     let mut sets = Sets((0..n).collect());
     let mut tree = Vec::new();
-    for (_, a, b) in edges {
+    for (w, a, b) in edges {
         let (ra, rb) = (sets.find(a), sets.find(b));
         if ra != rb {
             sets.0[ra] = rb;
-            tree.push((a, b));
+            tree.push((w, a, b));
         }
     }
     tree
@@ -81,7 +81,11 @@ pub fn spanning_tree(n: usize, mut edges: Vec<(f64, usize, usize)>) -> Vec<(usiz
 /// Each split the tree offers with both sides at least `min_group` views, once each: `true`
 /// marks the side cut off (the one without view 0). In a forest, the other trees stay with
 /// view 0's side.
-pub fn candidate_splits(n: usize, tree: &[(usize, usize)], min_group: usize) -> Vec<Vec<bool>> {
+pub fn candidate_splits(
+    n: usize,
+    tree: &[(f64, usize, usize)],
+    min_group: usize,
+) -> Vec<Vec<bool>> {
     let mut out = SplitList::default();
     for cut in 0..tree.len() {
         let side = cut_off(n, tree, cut);
@@ -104,14 +108,9 @@ pub fn weakest_link_split(
 ) -> Option<Vec<bool>> {
     let mut edges = links.to_vec();
     edges.extend((1..n).map(|v| (0.0, v - 1, v)));
-    let mut strength = BTreeMap::new();
-    for &(w, a, b) in &edges {
-        let s = strength.entry((a.min(b), a.max(b))).or_insert(w);
-        *s = f64::max(*s, w);
-    }
     let tree = spanning_tree(n, edges);
     let mut cuts: Vec<(f64, usize)> = (tree.iter().enumerate())
-        .map(|(k, &(a, b))| (strength[&(a.min(b), a.max(b))], k))
+        .map(|(k, &(w, _, _))| (w, k))
         .collect();
     cuts.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     cuts.into_iter()
@@ -121,17 +120,18 @@ pub fn weakest_link_split(
 }
 
 /// The views on the side of tree edge `cut`'s second view once the edge is cut.
-fn cut_off(n: usize, tree: &[(usize, usize)], cut: usize) -> Vec<bool> {
+fn cut_off(n: usize, tree: &[(f64, usize, usize)], cut: usize) -> Vec<bool> {
     let mut adjacent = vec![Vec::new(); n];
-    for (k, &(a, b)) in tree.iter().enumerate() {
+    for (k, &(_, a, b)) in tree.iter().enumerate() {
         if k != cut {
             adjacent[a].push(b);
             adjacent[b].push(a);
         }
     }
     let mut side = vec![false; n];
-    let mut stack = vec![tree[cut].1];
-    side[tree[cut].1] = true;
+    let second = tree[cut].2;
+    let mut stack = vec![second];
+    side[second] = true;
     while let Some(v) = stack.pop() {
         for &w in &adjacent[v] {
             if !side[w] {
