@@ -12,6 +12,7 @@
 //! what it assumes and its measurements.
 
 pub mod conflict;
+pub mod contradicted;
 pub mod evidence;
 pub mod join;
 pub mod plot;
@@ -109,6 +110,10 @@ pub struct ModelCheck<'e> {
     /// holds: no point, or points for under [`ANCHORED_FRACTION`] of their matched keypoints;
     /// sorted.
     pub unanchored: Vec<String>,
+    /// For a wrong model (ghosted, or placing a group or images elsewhere), the pairs inside
+    /// the groups it placed consistently whose matches it holds apart
+    /// ([`contradicted::refused_pairs`]): the repair blames them too. Sorted.
+    pub refused: Vec<[String; 2]>,
     /// Which group each image is in (0 or 1) for the worst split, by image name.
     #[serde(skip)]
     pub side: Vec<bool>,
@@ -216,6 +221,7 @@ pub fn check_model<'e>(
         misplaced_images: Vec::new(),
         ghost_of_images: false,
         unanchored: unanchored(&views),
+        refused: Vec::new(),
         side,
         weakest_link,
         views: Some(views),
@@ -480,6 +486,7 @@ pub fn check_run<'e>(
                         .collect();
                     c.ghost_of_images = !ghosted_without(model, &groups, &images, e, settings)?;
                 }
+                c.refused = refused(c);
             }
             let checked: Vec<_> = models
                 .iter()
@@ -528,6 +535,9 @@ impl RunCheck<'_> {
         for pair in images.clone().flat_map(|m| &m.against) {
             blamed.insert(pair.clone());
         }
+        for pair in self.models.iter().flat_map(|c| &c.refused) {
+            blamed.insert(pair.clone());
+        }
         // Each pair's matches in name order, merged where both images are misplaced.
         let mut dropped: BTreeMap<[String; 2], BTreeSet<[u32; 2]>> = BTreeMap::new();
         for h in images.clone().flat_map(|m| &m.holding) {
@@ -566,6 +576,35 @@ impl RunCheck<'_> {
                 .collect(),
         }
     }
+}
+
+/// The pairs a wrong model refused inside the groups it placed consistently: a ghost's two
+/// groups, or a misplaced group and the rest; else (one image alone, misplaced images) every
+/// image but those. Images placed elsewhere and unanchored ones belong to no group.
+fn refused(c: &ModelCheck) -> Vec<[String; 2]> {
+    let (Some(views), Some(worst)) = (&c.views, &c.worst) else {
+        return Vec::new();
+    };
+    if !(c.ghosted || c.places_elsewhere()) {
+        return Vec::new();
+    }
+    let two = c.ghost_of_groups() || c.misplaced.is_some();
+    let alone: Vec<&String> = match worst.groups.iter().find(|g| g.len() == 1) {
+        Some(g) if c.ghosted && !two => g.iter().collect(),
+        _ => Vec::new(),
+    };
+    let placed_elsewhere = |name: &String| {
+        alone.contains(&name)
+            || c.unanchored.contains(name)
+            || c.misplaced_images.iter().any(|m| &m.image == name)
+    };
+    let group: Vec<Option<bool>> = (views.views.iter())
+        .map(|v| {
+            let second = two && worst.groups[1].contains(&v.name);
+            (!placed_elsewhere(&v.name)).then_some(second)
+        })
+        .collect();
+    contradicted::refused_pairs(views, &group)
 }
 
 /// Whether the split into `groups` of `model` is still ghosted with `images` left out, and with

@@ -960,6 +960,7 @@ fn ghost_of_two(
         misplaced_images: images,
         ghost_of_images: of_images,
         unanchored: Vec::new(),
+        refused: Vec::new(),
         side: Vec::new(),
         weakest_link: None,
         views: None,
@@ -1027,4 +1028,170 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
         alone.blamed,
         [named("a.png", "c.png"), named("c.png", "d.png")]
     );
+}
+
+/// Matches of a pair whose keypoints the model holds on different points (each point of `a` to
+/// the next point id in `b`, where `b` has it): a pair the mapper refused.
+fn refused_matches(a: &SparseImage, b: &SparseImage) -> Vec<[u32; 2]> {
+    matches_of(a, b, |id| id + 1)
+}
+
+/// Adds the pair `a`, `b` with matches `m` to `e`.
+fn add_pair(e: &mut Evidence, a: &SparseImage, b: &SparseImage, m: Vec<[u32; 2]>) {
+    let key = (a.image.name.clone(), b.image.name.clone());
+    e.pairs.insert(key.clone(), m.len());
+    e.matches.insert(key, m);
+}
+
+/// Adds confirmed pairs (matches of the same points) tying `images` one after the other.
+fn chain(e: &mut Evidence, images: &[&SparseImage]) {
+    for w in images.windows(2) {
+        add_pair(e, w[0], w[1], matches_of(w[0], w[1], |id| id));
+    }
+}
+
+/// The check of `model` with `evidence`: ghosted, its refused pairs and the repair.
+fn refused_of(model: &SparseModel, evidence: &Evidence) -> (bool, Vec<[String; 2]>, ModelEvidence) {
+    let run = check_run(
+        std::slice::from_ref(model),
+        Some(evidence),
+        &DEFAULT_SETTINGS,
+    )
+    .unwrap();
+    let c = &run.models[0];
+    (c.ghosted, c.refused.clone(), run.evidence())
+}
+
+fn named(a: u32, b: u32) -> [String; 2] {
+    [format!("{a:04}.png"), format!("{b:04}.png")]
+}
+
+/// A wrong model's refused pairs are blamed among the images it placed consistently: with one
+/// image on the other copy, a pair of two other images that the model's confirmed pairs tie
+/// together and whose matches it holds apart is refused; one it holds as points is not, nor
+/// one of an image no confirmed pair ties to the rest (placed apart from its group), and the
+/// misplaced image's own pairs are judged by its blame alone; a clean model refuses nothing.
+#[test]
+fn a_wrong_model_refuses_the_pairs_it_holds_apart_among_the_rest() {
+    for misplaced in [true, false] {
+        let model = one_image_model(misplaced);
+        let im = &model.images;
+        let mut evidence = Evidence::default();
+        chain(&mut evidence, &im[..11].iter().collect::<Vec<_>>());
+        add_pair(
+            &mut evidence,
+            &im[2],
+            &im[8],
+            refused_matches(&im[2], &im[8]),
+        );
+        add_pair(
+            &mut evidence,
+            &im[4],
+            &im[11],
+            refused_matches(&im[4], &im[11]),
+        );
+        add_pair(
+            &mut evidence,
+            &im[3],
+            &im[12],
+            refused_matches(&im[3], &im[12]),
+        );
+        let (ghosted, refused, repair) = refused_of(&model, &evidence);
+        assert_eq!(ghosted, misplaced);
+        if misplaced {
+            assert_eq!(refused, [named(3, 9)]);
+            assert!(repair.blamed.contains(&named(3, 9)));
+        } else {
+            assert!(
+                refused.is_empty() && repair.blamed.is_empty(),
+                "{refused:?}"
+            );
+        }
+    }
+}
+
+/// A ghost of two groups refuses inside each group, not across: there a pair held apart is a
+/// true link the ghost broke.
+#[test]
+fn a_ghost_refuses_pairs_inside_its_groups_only() {
+    let model = ghosted_model();
+    let im = &model.images;
+    let mut evidence = Evidence::default();
+    // Odd images saw the first wall, even ones the second.
+    chain(&mut evidence, &im.iter().step_by(2).collect::<Vec<_>>());
+    chain(
+        &mut evidence,
+        &im.iter().skip(1).step_by(2).collect::<Vec<_>>(),
+    );
+    add_pair(
+        &mut evidence,
+        &im[0],
+        &im[4],
+        refused_matches(&im[0], &im[4]),
+    );
+    add_pair(
+        &mut evidence,
+        &im[1],
+        &im[5],
+        refused_matches(&im[1], &im[5]),
+    );
+    add_pair(
+        &mut evidence,
+        &im[0],
+        &im[3],
+        refused_matches(&im[0], &im[3]),
+    );
+    let (ghosted, refused, _) = refused_of(&model, &evidence);
+    assert!(ghosted);
+    assert_eq!(refused, [named(1, 5), named(2, 6)]);
+}
+
+/// The matches that hold a misplaced image where the model put it are those its matches' pose
+/// puts far off (another copy's look), not those it misses by less than
+/// [`resection::HOLDING_FAR`] of the diagonal: image 5 moved 1 or 2 units along a wall 5 units
+/// away, with 40 more keypoints where the model's pose sees points of image 3, matched to them.
+/// From the wall they are 80 px (1 unit) or 160 px (2 units) off the matches' pose: only the
+/// second hold it.
+#[test]
+fn only_matches_far_from_the_matches_pose_hold_a_misplaced_image() {
+    for (shift, held) in [(1.0, false), (2.0, true)] {
+        let mut model = correct_model();
+        let mut evidence = Evidence::default();
+        for k in [2, 3, 5, 6] {
+            let m = matches_of(&model.images[4], &model.images[k], |id| id);
+            let key = (
+                model.images[4].image.name.clone(),
+                model.images[k].image.name.clone(),
+            );
+            evidence.matches.insert(key, m);
+        }
+        model.images[4].image.translation.x -= shift;
+        let intrinsics = views::Intrinsics::from_camera(&camera());
+        let (pose, points) = (model.images[4].image.clone(), model.points.clone());
+        let extra: Vec<(u32, [f64; 2])> = (model.images[3].points2d.iter().enumerate())
+            .filter_map(|(k, p)| {
+                let x = Vector3::from(points[&p.point3d_id?]);
+                let xy = intrinsics.project(&(pose.rotation * x + pose.translation))?;
+                Some((k as u32, xy))
+            })
+            .take(40)
+            .collect();
+        let first = model.images[4].points2d.len() as u32;
+        // Keyed (image 5, image 4), as above.
+        let key = ("0005.png".to_string(), "0004.png".to_string());
+        let matches = evidence.matches.get_mut(&key).unwrap();
+        for (n, (k, xy)) in extra.iter().enumerate() {
+            model.images[4].points2d.push(Point2D {
+                xy: *xy,
+                point3d_id: None,
+            });
+            matches.push([first + n as u32, *k]);
+        }
+        let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+        let [m] = &run.models[0].misplaced_images[..] else {
+            panic!("{:?}", run.models[0].misplaced_images)
+        };
+        let holding: usize = m.holding.iter().map(|h| h.matches.len()).sum();
+        assert_eq!(holding, if held { extra.len() } else { 0 }, "shift {shift}");
+    }
 }

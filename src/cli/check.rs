@@ -322,6 +322,7 @@ mod tests {
             misplaced_images: Vec::new(),
             ghost_of_images: false,
             unanchored: Vec::new(),
+            refused: Vec::new(),
             side: Vec::new(),
             weakest_link: None,
             views: None,
