@@ -60,7 +60,8 @@ pub struct PruneArgs {
     #[arg(long, value_name = "FILE", help_heading = SELECT)]
     forbid_images: Option<PathBuf>,
     /// A mapper's output on this database (a model folder or its output_path), for the repair
-    /// loop: the pairs that glued a model `check` finds ghosted are never selected, the pairs
+    /// loop: the pairs that glued a model `check` finds ghosted, and those a wrong model
+    /// refused among the images it placed consistently, are never selected, the pairs
     /// that link clean models `check` joins or place a misplaced image back are kept, and the
     /// matches that held a misplaced image are dropped from the pairs kept (docs/check.md).
     /// Repeat it with every earlier turn's output, in order, so that no turn selects again what

@@ -43,9 +43,9 @@ pub struct ArcRules {
     pub forbid_pairs: Option<PathBuf>,
     /// `--forbid_images`: the file of images never selected.
     pub forbid_images: Option<PathBuf>,
-    /// `--model`: mappers' outputs on this database; the pairs that glued a model the check
-    /// finds ghosted, in any of them, are never selected, and the pairs that link clean models
-    /// are kept.
+    /// `--model`: mappers' outputs on this database; the pairs the check blames in any of them
+    /// (that glued a ghost, or that a wrong model refused) are never selected, and the pairs
+    /// that link clean models are kept.
     pub model: Vec<PathBuf>,
 }
 
