@@ -845,25 +845,28 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
     assert_eq!(evidence.links.len(), g.links.len());
 }
 
+/// The correct model with image 5 moved `shift` units along the wall, and its matches to
+/// images 3, 4, 6 and 7 (keyed image 5 first).
+fn with_shift(shift: f64) -> (SparseModel, Evidence) {
+    let mut model = correct_model();
+    let mut evidence = Evidence::default();
+    for k in [2, 3, 5, 6] {
+        let m = matches_of(&model.images[4], &model.images[k], |id| id);
+        let key = (
+            model.images[4].image.name.clone(),
+            model.images[k].image.name.clone(),
+        );
+        evidence.matches.insert(key, m);
+    }
+    model.images[4].image.translation.x -= shift;
+    (model, evidence)
+}
+
 /// An image the model holds one unit to the side of where its keypoints see the wall: its
 /// matches to its neighbours' points place it back, by the pairs that then link it; held in
 /// place, or eight units off, nothing is misplaced.
 #[test]
 fn an_image_its_matches_place_elsewhere_is_misplaced() {
-    let with_shift = |shift: f64| {
-        let mut model = correct_model();
-        let mut evidence = Evidence::default();
-        for k in [2, 3, 5, 6] {
-            let m = matches_of(&model.images[4], &model.images[k], |id| id);
-            let key = (
-                model.images[4].image.name.clone(),
-                model.images[k].image.name.clone(),
-            );
-            evidence.matches.insert(key, m);
-        }
-        model.images[4].image.translation.x -= shift;
-        (model, evidence)
-    };
     let (model, evidence) = with_shift(0.0);
     let in_place = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
     assert!(in_place.models[0].misplaced_images.is_empty());
@@ -1043,6 +1046,11 @@ fn add_pair(e: &mut Evidence, a: &SparseImage, b: &SparseImage, m: Vec<[u32; 2]>
     e.matches.insert(key, m);
 }
 
+/// Adds the pair `a`, `b` with [`refused_matches`].
+fn add_refused(e: &mut Evidence, a: &SparseImage, b: &SparseImage) {
+    add_pair(e, a, b, refused_matches(a, b));
+}
+
 /// Adds confirmed pairs (matches of the same points) tying `images` one after the other.
 fn chain(e: &mut Evidence, images: &[&SparseImage]) {
     for w in images.windows(2) {
@@ -1078,24 +1086,9 @@ fn a_wrong_model_refuses_the_pairs_it_holds_apart_among_the_rest() {
         let im = &model.images;
         let mut evidence = Evidence::default();
         chain(&mut evidence, &im[..11].iter().collect::<Vec<_>>());
-        add_pair(
-            &mut evidence,
-            &im[2],
-            &im[8],
-            refused_matches(&im[2], &im[8]),
-        );
-        add_pair(
-            &mut evidence,
-            &im[4],
-            &im[11],
-            refused_matches(&im[4], &im[11]),
-        );
-        add_pair(
-            &mut evidence,
-            &im[3],
-            &im[12],
-            refused_matches(&im[3], &im[12]),
-        );
+        add_refused(&mut evidence, &im[2], &im[8]);
+        add_refused(&mut evidence, &im[4], &im[11]);
+        add_refused(&mut evidence, &im[3], &im[12]);
         let (ghosted, refused, repair) = refused_of(&model, &evidence);
         assert_eq!(ghosted, misplaced);
         if misplaced {
@@ -1123,24 +1116,9 @@ fn a_ghost_refuses_pairs_inside_its_groups_only() {
         &mut evidence,
         &im.iter().skip(1).step_by(2).collect::<Vec<_>>(),
     );
-    add_pair(
-        &mut evidence,
-        &im[0],
-        &im[4],
-        refused_matches(&im[0], &im[4]),
-    );
-    add_pair(
-        &mut evidence,
-        &im[1],
-        &im[5],
-        refused_matches(&im[1], &im[5]),
-    );
-    add_pair(
-        &mut evidence,
-        &im[0],
-        &im[3],
-        refused_matches(&im[0], &im[3]),
-    );
+    add_refused(&mut evidence, &im[0], &im[4]);
+    add_refused(&mut evidence, &im[1], &im[5]);
+    add_refused(&mut evidence, &im[0], &im[3]);
     let (ghosted, refused, _) = refused_of(&model, &evidence);
     assert!(ghosted);
     assert_eq!(refused, [named(1, 5), named(2, 6)]);
@@ -1155,17 +1133,7 @@ fn a_ghost_refuses_pairs_inside_its_groups_only() {
 #[test]
 fn only_matches_far_from_the_matches_pose_hold_a_misplaced_image() {
     for (shift, held) in [(1.0, false), (2.0, true)] {
-        let mut model = correct_model();
-        let mut evidence = Evidence::default();
-        for k in [2, 3, 5, 6] {
-            let m = matches_of(&model.images[4], &model.images[k], |id| id);
-            let key = (
-                model.images[4].image.name.clone(),
-                model.images[k].image.name.clone(),
-            );
-            evidence.matches.insert(key, m);
-        }
-        model.images[4].image.translation.x -= shift;
+        let (mut model, mut evidence) = with_shift(shift);
         let intrinsics = views::Intrinsics::from_camera(&camera());
         let (pose, points) = (model.images[4].image.clone(), model.points.clone());
         let extra: Vec<(u32, [f64; 2])> = (model.images[3].points2d.iter().enumerate())
