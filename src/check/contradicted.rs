@@ -33,21 +33,20 @@ pub fn refused_pairs(views: &Views, group: &[Option<bool>]) -> Vec<[String; 2]> 
         }
         v
     }
-    for a in 0..n {
-        for b in a + 1..n {
-            if group[a].is_none() || group[a] != group[b] {
-                continue;
-            }
-            let (joined, apart) = views.matches_held(a, b);
-            if joined + apart < MIN_HELD {
-                continue;
-            }
-            if apart as f64 > APART_RATIO * joined as f64 {
-                judged.push((a, b));
-            } else if joined >= apart {
-                let (ra, rb) = (root(&mut component, a), root(&mut component, b));
-                component[ra] = rb;
-            }
+    // The pairs with matches; the components do not depend on their order.
+    for &(a, b) in views.matches.keys() {
+        if group[a].is_none() || group[a] != group[b] {
+            continue;
+        }
+        let (joined, apart) = views.matches_held(a, b);
+        if joined + apart < MIN_HELD {
+            continue;
+        }
+        if apart as f64 > APART_RATIO * joined as f64 {
+            judged.push((a, b));
+        } else if joined >= apart {
+            let (ra, rb) = (root(&mut component, a), root(&mut component, b));
+            component[ra] = rb;
         }
     }
     let mut out: Vec<[String; 2]> = judged
