@@ -8,6 +8,7 @@
 //! look-alike's own false pairs to its neighbours free, and the next run put the look-alike
 //! there (street seed 72).
 
+use super::splits::Sets;
 use super::views::Views;
 
 /// A pair is judged with at least this many of its matches on points in both images...
@@ -23,16 +24,8 @@ pub const APART_RATIO: f64 = 1.5;
 /// group, seed 79) are not placed consistently with it, and refusing their pairs to it would
 /// tear them off.
 pub fn refused_pairs(views: &Views, group: &[Option<bool>]) -> Vec<[String; 2]> {
-    let n = views.views.len();
     let mut judged = Vec::new();
-    let mut component: Vec<usize> = (0..n).collect();
-    fn root(c: &mut [usize], mut v: usize) -> usize {
-        while c[v] != v {
-            c[v] = c[c[v]];
-            v = c[v];
-        }
-        v
-    }
+    let mut tied = Sets::new(views.views.len());
     // The pairs with matches; the components do not depend on their order.
     for &(a, b) in views.matches.keys() {
         if group[a].is_none() || group[a] != group[b] {
@@ -45,20 +38,15 @@ pub fn refused_pairs(views: &Views, group: &[Option<bool>]) -> Vec<[String; 2]> 
         if apart as f64 > APART_RATIO * joined as f64 {
             judged.push((a, b));
         } else if joined >= apart {
-            let (ra, rb) = (root(&mut component, a), root(&mut component, b));
-            component[ra] = rb;
+            tied.union(a, b);
         }
     }
     let mut out: Vec<[String; 2]> = judged
         .into_iter()
-        .filter(|&(a, b)| root(&mut component, a) == root(&mut component, b))
+        .filter(|&(a, b)| tied.find(a) == tied.find(b))
         .map(|(a, b)| {
             let (x, y) = (&views.views[a].name, &views.views[b].name);
-            if x < y {
-                [x.clone(), y.clone()]
-            } else {
-                [y.clone(), x.clone()]
-            }
+            [x.min(y).clone(), x.max(y).clone()]
         })
         .collect();
     out.sort();

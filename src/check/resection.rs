@@ -80,8 +80,8 @@ pub struct ImagePlacement {
     /// where the model put it (`prune --model` blames them).
     pub against: Vec<[String; 2]>,
     /// The matches whose correspondence agrees with the model's pose and is far from the
-    /// matches' ([`HOLDING_FAR`]): for a misplaced image, what holds it where the model put it, inside pairs
-    /// that may be true (a hall camera registered 98 degrees off onto an object's repeated
+    /// matches' ([`HOLDING_FAR`]): for a misplaced image, what holds it where the model put
+    /// it, inside pairs that may be true (a hall camera registered 98 degrees off onto an object's repeated
     /// face by a few dozen such matches among its true pairs' inliers). `prune --model` drops
     /// them from the pairs it keeps (in the report under `repair`).
     #[serde(skip)]
@@ -188,16 +188,15 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
             .project(&(r * views.points[k.point] + t))
             .map_or(f64::INFINITY, |q| (q[0] - k.xy[0]).hypot(q[1] - k.xy[1]))
     };
-    let agrees =
-        |r: &Matrix3<f64>, t: &Vector3<f64>, k: &Correspondence| error(r, t, k) <= AGREE_PX;
     let far = HOLDING_FAR * view.intrinsics.width.hypot(view.intrinsics.height);
     // Per other view: correspondences, those agreeing with the model's pose and those
     // agreeing with the matches'; and the matches that hold the image where the model put it.
     let mut pairs: Vec<(usize, [usize; 3], Vec<[u32; 2]>)> = Vec::new();
     let (mut model_support, mut support) = (0, 0);
     for k in &c {
-        let m = usize::from(agrees(&view.rotation, &view.translation, k));
-        let s = usize::from(agrees(&rotation, &translation, k));
+        let off = error(&rotation, &translation, k);
+        let m = usize::from(error(&view.rotation, &view.translation, k) <= AGREE_PX);
+        let s = usize::from(off <= AGREE_PX);
         (model_support, support) = (model_support + m, support + s);
         let Some(matched) = k.matched else { continue };
         if pairs.last().is_none_or(|last| last.0 != k.view) {
@@ -205,7 +204,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
         }
         let last = pairs.last_mut().expect("pushed above");
         last.1 = [last.1[0] + 1, last.1[1] + m, last.1[2] + s];
-        if m == 1 && error(&rotation, &translation, k) > far {
+        if m == 1 && off > far {
             last.2.push(matched);
         }
     }

@@ -49,10 +49,23 @@ impl Covisibility {
 }
 
 /// Union-find over view indices.
-struct Sets(Vec<usize>);
+pub(super) struct Sets(Vec<usize>);
 
 impl Sets {
-    fn find(&mut self, a: usize) -> usize {
+    /// `n` views, each a set of its own.
+    pub(super) fn new(n: usize) -> Sets {
+        Sets((0..n).collect())
+    }
+
+    /// Joins the sets of `a` and `b`; false where they were one already.
+    pub(super) fn union(&mut self, a: usize, b: usize) -> bool {
+        let (ra, rb) = (self.find(a), self.find(b));
+        self.0[ra] = rb;
+        ra != rb
+    }
+
+    /// The representative of `a`'s set.
+    pub(super) fn find(&mut self, a: usize) -> usize {
         let mut r = a;
         while self.0[r] != r {
             r = self.0[r];
@@ -66,12 +79,10 @@ impl Sets {
 /// by view indices): the edges it keeps, as given.
 pub fn spanning_tree(n: usize, mut edges: Vec<(f64, usize, usize)>) -> Vec<(f64, usize, usize)> {
     edges.sort_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-    let mut sets = Sets((0..n).collect());
+    let mut sets = Sets::new(n);
     let mut tree = Vec::new();
     for (w, a, b) in edges {
-        let (ra, rb) = (sets.find(a), sets.find(b));
-        if ra != rb {
-            sets.0[ra] = rb;
+        if sets.union(a, b) {
             tree.push((w, a, b));
         }
     }
@@ -239,7 +250,7 @@ pub fn component_splits(
     edges: &[(f64, usize, usize)],
     min_group: usize,
 ) -> Vec<Vec<bool>> {
-    let mut sets = Sets((0..n).collect());
+    let mut sets = Sets::new(n);
     for &(_, a, b) in edges {
         let (ra, rb) = (sets.find(a), sets.find(b));
         if ra != rb {

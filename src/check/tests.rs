@@ -1070,7 +1070,8 @@ fn refused_of(model: &SparseModel, evidence: &Evidence) -> (bool, Vec<[String; 2
     (c.ghosted, c.refused.clone(), run.evidence())
 }
 
-fn named(a: u32, b: u32) -> [String; 2] {
+/// The names of images `a` and `b`.
+fn image_pair(a: u32, b: u32) -> [String; 2] {
     [format!("{a:04}.png"), format!("{b:04}.png")]
 }
 
@@ -1092,8 +1093,8 @@ fn a_wrong_model_refuses_the_pairs_it_holds_apart_among_the_rest() {
         let (ghosted, refused, repair) = refused_of(&model, &evidence);
         assert_eq!(ghosted, misplaced);
         if misplaced {
-            assert_eq!(refused, [named(3, 9)]);
-            assert!(repair.blamed.contains(&named(3, 9)));
+            assert_eq!(refused, [image_pair(3, 9)]);
+            assert!(repair.blamed.contains(&image_pair(3, 9)));
         } else {
             assert!(
                 refused.is_empty() && repair.blamed.is_empty(),
@@ -1121,7 +1122,7 @@ fn a_ghost_refuses_pairs_inside_its_groups_only() {
     add_refused(&mut evidence, &im[0], &im[3]);
     let (ghosted, refused, _) = refused_of(&model, &evidence);
     assert!(ghosted);
-    assert_eq!(refused, [named(1, 5), named(2, 6)]);
+    assert_eq!(refused, [image_pair(1, 5), image_pair(2, 6)]);
 }
 
 /// The matches that hold a misplaced image where the model put it are those its matches' pose
