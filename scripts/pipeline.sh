@@ -20,7 +20,10 @@
 #                   check` on the last model, and where its report's `repair` is not empty
 #                   (a ghost's pairs to blame, or pairs that place a misplaced group or join
 #                   clean models), `prune --model` with every model so far and one more mapper run,
-#                   a row `repairedK` per turn [0]
+#                   a row `repairedK` per turn [0]; in a repair turn, the images the database
+#                   links and the mapper left out (a piece the blame cut off: COLMAP 3.8 starts
+#                   no second model from narrow pairs) are mapped on their own into
+#                   sparse_repairedK/left, counted in the mapper's seconds (README)
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -71,6 +74,22 @@ log "prune $prune_args"
 # The pruned database was just rewritten, so its reconstruction is redone.
 rm -f "$work/sparse_pruned.seconds"
 
+# A repair turn's second mapper run, on the images its database links and its first run left
+# out, into sparse_VARIANT/left (where `check --model` and `prune --model` see it as the same
+# run's); its seconds are added to the turn's.
+map_left_out() {
+  local variant=$1 sparse=$work/sparse_$1 left=$work/left_$1.txt seconds
+  "$bin" check --model "$sparse" --database_path "$work/$variant.db" --unregistered "$left" \
+    >/dev/null || [ $? = 3 ]
+  [ -s "$left" ] || return 0
+  log "mapper on the $(wc -l <"$left") images the $variant model left out"
+  mkdir -p "$sparse/left"
+  seconds=$(timed "$work/mapper_${variant}_left.log" colmap mapper \
+    --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse/left" \
+    --image_list_path "$left" --Mapper.extract_colors 0)
+  echo "$(cat "$sparse.seconds") + $seconds" | bc >"$sparse.seconds"
+}
+
 # The mapper on one database of WORKDIR (full, pruned or repaired) and the eval of its model.
 map_and_eval() {
   local variant=$1 sparse=$work/sparse_$1
@@ -80,6 +99,7 @@ map_and_eval() {
     log "mapper on the $variant database"
     timed "$work/mapper_$variant.log" colmap mapper --database_path "$work/$variant.db" \
       --image_path "$images" --output_path "$sparse" --Mapper.extract_colors 0 >"$sparse.seconds"
+    [[ $variant == repaired* ]] && map_left_out "$variant"
   fi
   eval_args=(--model "$sparse" --database_path "$work/$variant.db")
   [ -n "$gt" ] && eval_args+=(--ground_truth "$gt")

@@ -66,7 +66,19 @@ fn check_exit_statuses_report_and_plots() {
         serde_json::json!({ "blamed": [], "dropped": [], "links": [] })
     );
     assert_eq!(value["models"][0]["images"], 2);
+    assert_eq!(value["unregistered"], serde_json::json!([]));
     assert!(plots.join("top_view_0.svg").is_file());
+    // The images left out are the database's to tell.
+    let left = dir.path().join("left.txt");
+    let out = vgsel(&[
+        "check",
+        "--model",
+        sparse.to_str().unwrap(),
+        "--unregistered",
+        left.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    assert!(!left.exists());
     let missing = dir.path().join("nothing");
     let out = vgsel(&["check", "--model", missing.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1), "{out:?}");
@@ -132,6 +144,7 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
         let model = work.join(format!("sparse_{variant}"));
         let db = work.join(format!("{variant}.db"));
         let report = work.join(format!("check_{variant}.json"));
+        let left = work.join(format!("left_{variant}.txt"));
         let out = vgsel(&[
             "check",
             "--model",
@@ -140,7 +153,16 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
             db.to_str().unwrap(),
             "--report",
             report.to_str().unwrap(),
+            "--unregistered",
+            left.to_str().unwrap(),
         ]);
+        // The list a second mapper run would read: images no model registered, none when
+        // all 20 are (as COLMAP 3.8 registers them here).
+        let listed = std::fs::read_to_string(&left).unwrap();
+        let images = eval["images"].as_array().unwrap();
+        let registered: Vec<&str> = images.iter().map(|i| i["name"].as_str().unwrap()).collect();
+        assert!(listed.lines().all(|n| !registered.contains(&n)), "{listed}");
+        assert_eq!(listed.is_empty(), registered.len() == 20, "{listed}");
         placements_agree_with_the_check(&model, &db, &dir.path().join("gt"), &report);
         let line = String::from_utf8_lossy(&out.stdout).to_string();
         eprintln!(

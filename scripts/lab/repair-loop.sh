@@ -9,7 +9,12 @@
 # with --model and maps once more. Every model is scored against the ground truth.
 # Prints one row per run and mapper; writes WORKDIR/loop.json.
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
-# most [3], each passing every earlier model to `prune --model`.
+# most [3], each passing every earlier model to `prune --model`. REPAIR_INIT_ANGLE: COLMAP 3.8's
+# initial-pair angle in the repair turns (--Mapper.init_min_tri_angle) [COLMAP's own, 16]; the
+# first mapper run keeps COLMAP's defaults. 8 was measured and not adopted (docs/check.md).
+# LEFT_OUT: in a repair turn with COLMAP 3.8, map the images the database links and the run left
+# out on their own into the turn's folder (`check --unregistered`, as the README says) [1]; 0:
+# not (the loop before session 23).
 # usage: scripts/lab/repair-loop.sh [WORKDIR] [RUNS] [MAPPERS]
 #        (defaults: target/repair-loop, 5, "global incremental")
 set -euo pipefail
@@ -21,11 +26,25 @@ turns=${TURNS:-3}
 # shellcheck source=scripts/lab/demo-matching.sh
 source scripts/lab/demo-matching.sh
 demo_setup "$work"
-map_with() { # MAPPER DB OUT: COLMAP 3.8's mapper (colmap3.8) or pycolmap's (global, incremental)
+map_with() { # MAPPER DB OUT [REPAIR]: COLMAP 3.8's mapper (colmap3.8) or pycolmap's (global,
+  # incremental); REPAIR not empty: a repair turn's run
+  local init=()
+  [ -n "${4:-}" ] && [ -n "${REPAIR_INIT_ANGLE:-}" ] &&
+    init=(--Mapper.init_min_tri_angle "$REPAIR_INIT_ANGLE")
   if [ "$1" = colmap3.8 ]; then
     mkdir -p "$3"
-    nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3" >"$3.log" 2>&1
+    nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3" \
+      "${init[@]}" >"$3.log" 2>&1
     echo '{}' >"$3.json"
+    if [ -n "${4:-}" ] && [ "${LEFT_OUT:-1}" = 1 ]; then
+      "$bin" check --model "$3" --database_path "$2" --unregistered "$3.left" >/dev/null ||
+        [ $? = 3 ]
+      if [ -s "$3.left" ]; then
+        mkdir -p "$3/left"
+        nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3/left" \
+          --image_list_path "$3.left" "${init[@]}" >"$3.left.log" 2>&1
+      fi
+    fi
   else
     nice "$PY" scripts/ci/colmap4.py map "$1" "$2" "$images" "$3" >"$3.json" 2>"$3.log"
   fi
@@ -51,7 +70,7 @@ for run in $(seq 1 "$runs"); do
       models=()
       for step in $(seq 1 $((turns + 1))); do
         model=$dir/${mapper}_$step
-        map_with "$mapper" "$db" "$model"
+        map_with "$mapper" "$db" "$model" "${models[*]}"
         score "$model" "$db" >"$model.eval.json"
         status=0
         "$bin" check --model "$model" --database_path "$db" \

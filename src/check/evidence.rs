@@ -7,8 +7,9 @@
 //! such a model for two copies (measured on Cup and Books: docs/check.md).
 
 use crate::colmap::database::Database;
+use crate::colmap::sparse::SparseModel;
 use anyhow::Result;
-use std::collections::{BTreeMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashSet};
 
 /// Image names of a pair, in name order.
 pub type NamePair = (String, String);
@@ -60,5 +61,27 @@ impl Evidence {
             matches.insert(key, inliers);
         }
         Ok(Evidence { pairs, matches })
+    }
+
+    /// The images that a pair a mapper would use (at least `min_num_matches` inliers) links and
+    /// that no model of `models` registered, in name order. COLMAP 3.8 relaxes its initial
+    /// pair (16 degrees, then 8) only while it has no model at all, so a piece of the view
+    /// graph that a repair's blame cut off, whose neighbours see their surroundings under small
+    /// angles (a street walked past), starts no model in the run that registers the rest; a
+    /// second run on these images alone starts one (README; docs/check.md, "Pieces that start no
+    /// model"). COLMAP 4's incremental mapper relaxes while images are left over.
+    pub fn unregistered(&self, models: &[SparseModel], min_num_matches: usize) -> Vec<String> {
+        let registered: HashSet<&str> = (models.iter())
+            .flat_map(|m| &m.images)
+            .map(|im| im.image.name.as_str())
+            .collect();
+        let linked: BTreeSet<&String> = (self.pairs.iter())
+            .filter(|(_, &inliers)| inliers >= min_num_matches)
+            .flat_map(|((a, b), _)| [a, b])
+            .collect();
+        (linked.into_iter())
+            .filter(|name| !registered.contains(name.as_str()))
+            .cloned()
+            .collect()
     }
 }

@@ -1164,3 +1164,26 @@ fn only_matches_far_from_the_matches_pose_hold_a_misplaced_image() {
         assert_eq!(holding, if held { extra.len() } else { 0 }, "shift {shift}");
     }
 }
+
+#[test]
+fn images_a_usable_pair_links_and_no_model_registered_are_unregistered() {
+    let models = [correct_model()];
+    let pair = |a: &str, b: &str| (a.to_string(), b.to_string());
+    let evidence = Evidence {
+        pairs: [
+            (pair("0001.png", "0013.png"), 20),
+            (pair("0014.png", "0015.png"), 14),
+            (pair("0002.png", "0003.png"), 40),
+        ]
+        .into_iter()
+        .collect(),
+        matches: BTreeMap::new(),
+    };
+    // 0014 and 0015 share fewer inliers than the mapper uses: nothing links them.
+    assert_eq!(evidence.unregistered(&models, 15), ["0013.png"]);
+    assert_eq!(
+        evidence.unregistered(&models, 14),
+        ["0013.png", "0014.png", "0015.png"]
+    );
+    assert!(Evidence::default().unregistered(&models, 15).is_empty());
+}

@@ -11,6 +11,7 @@ use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
 use vgsel_colmap::colmap::sparse::read_sparse_model;
 use vgsel_colmap::geometry::similarity::Similarity;
+use vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 
 /// Exit status of a check that found a model wrong: ghosted, with a misplaced group, or with
 /// images registered on (next to) no 3D point.
@@ -33,6 +34,11 @@ pub struct CheckArgs {
     /// Write each model's top view (cameras coloured by group) as SVG into DIR.
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
+    /// Write the images that the database's usable pairs link and no model registered, one name
+    /// a line, as `colmap mapper --image_list_path` reads them (empty when there are none):
+    /// with COLMAP 3.8, a repair turn maps them on their own into DIR/left (README).
+    #[arg(long, value_name = "FILE", requires = "database_path")]
+    unregistered: Option<PathBuf>,
     /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = super::args::fraction)]
     threshold: f64,
@@ -199,6 +205,22 @@ fn examples<'a>(pairs: impl Iterator<Item = (&'a String, &'a String)>) -> String
         .join(" ")
 }
 
+/// The line for images the database links and no model registered (at least one).
+fn unregistered_line(names: &[String]) -> String {
+    let shown: Vec<&str> = names.iter().take(5).map(String::as_str).collect();
+    let more = if names.len() > shown.len() {
+        " ..."
+    } else {
+        ""
+    };
+    format!(
+        "{} images the database's pairs link are in no model: {}{more} (with COLMAP 3.8, map them \
+         on their own: --unregistered FILE, then colmap mapper --image_list_path FILE)",
+        names.len(),
+        shown.join(" ")
+    )
+}
+
 /// The line a join gets: the two models, how many pairs link them and how well they agree.
 fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
     let judged = j.counts.conflicting + j.counts.agreeing;
@@ -277,6 +299,17 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             .into();
         joined.push(value);
     }
+    let unregistered = match &evidence {
+        Some(e) => e.unregistered(&models, DEFAULT_MIN_NUM_MATCHES),
+        None => Vec::new(),
+    };
+    if !unregistered.is_empty() {
+        println!("{}", unregistered_line(&unregistered));
+    }
+    if let Some(path) = &args.unregistered {
+        let lines: String = unregistered.iter().map(|n| format!("{n}\n")).collect();
+        std::fs::write(path, lines).with_context(|| format!("writing {}", path.display()))?;
+    }
     if let Some(path) = &args.report {
         let report = serde_json::json!({
             "ghosted": ghosted,
@@ -285,6 +318,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             "settings": settings,
             "models": reports,
             "joins": joined,
+            "unregistered": unregistered,
             "repair": run.evidence(),
         });
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")

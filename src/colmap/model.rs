@@ -132,17 +132,30 @@ pub fn write_text_model(dir: &Path, cameras: &[ModelCamera], images: &[ModelImag
 }
 
 /// The model folders under `dir`: `dir` itself when it holds a model, else its sub-folders that
-/// do, in name order (COLMAP numbers them 0, 1, ...; the first is the largest).
+/// do, in name order (COLMAP numbers them 0, 1, ...; the first is the largest), then the models
+/// of its sub-folders that are mapper outputs themselves: a second run on the images the first
+/// left out, written into the first's folder (`sparse2/left`, README), belongs to the same run.
 pub fn model_dirs(dir: &Path) -> Result<Vec<PathBuf>> {
     let is_model = |d: &Path| d.join("images.bin").is_file() || d.join("images.txt").is_file();
     if is_model(dir) {
         return Ok(vec![dir.to_path_buf()]);
     }
+    let (models, others): (Vec<PathBuf>, Vec<PathBuf>) =
+        sub_folders(dir)?.into_iter().partition(|p| is_model(p));
+    let mut dirs = models;
+    for other in others {
+        dirs.extend(sub_folders(&other)?.into_iter().filter(|p| is_model(p)));
+    }
+    Ok(dirs)
+}
+
+/// The folders in `dir`, numbered ones first in their order, then the rest by name.
+fn sub_folders(dir: &Path) -> Result<Vec<PathBuf>> {
     let entries = std::fs::read_dir(dir)
         .with_context(|| format!("cannot read model folder {}", dir.display()))?;
     let mut dirs: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| is_model(p))
+        .filter(|p| p.is_dir())
         .collect();
     dirs.sort_by_key(|p| {
         let name = p

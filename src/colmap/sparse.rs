@@ -390,6 +390,16 @@ mod tests {
         );
         std::fs::write(model.join("images.bin"), &bin).unwrap();
         assert_eq!(model_dirs(dir.path()).unwrap(), vec![model.clone()]);
+        // A second mapper run written into the first's folder belongs to the run; a folder
+        // deeper down does not, nor does an empty one.
+        let (left, deeper) = (dir.path().join("left/0"), dir.path().join("left/x/0"));
+        for d in [&left, &deeper, &dir.path().join("empty")] {
+            std::fs::create_dir_all(d).unwrap();
+        }
+        std::fs::write(left.join("images.bin"), &bin).unwrap();
+        std::fs::write(deeper.join("images.bin"), &bin).unwrap();
+        let found = model_dirs(dir.path()).unwrap();
+        assert_eq!(found, vec![model.clone(), left.clone()]);
         let images = read_images(&model).unwrap();
         assert_eq!(
             (
