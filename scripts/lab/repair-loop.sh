@@ -36,7 +36,8 @@ map_with() { # MAPPER DB OUT [REPAIR]: COLMAP 3.8's mapper (colmap3.8) or pycolm
     nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3" \
       "${init[@]}" >"$3.log" 2>&1
     echo '{}' >"$3.json"
-    if [ -n "${4:-}" ] && [ "${LEFT_OUT:-1}" = 1 ]; then
+    # A repair turn that made a model (with none, COLMAP relaxed its initial pair already).
+    if [ -n "${4:-}" ] && [ "${LEFT_OUT:-1}" = 1 ] && [ -n "$(ls -A "$3")" ]; then
       "$bin" check --model "$3" --database_path "$2" --unregistered "$3.left" >/dev/null ||
         [ $? = 3 ]
       if [ -s "$3.left" ]; then
