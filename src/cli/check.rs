@@ -9,7 +9,7 @@ use vgsel_colmap::check::evidence::Evidence;
 use vgsel_colmap::check::{self, CheckSettings, ModelCheck, DEFAULT_SETTINGS};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
-use vgsel_colmap::colmap::sparse::read_sparse_model;
+use vgsel_colmap::colmap::sparse::{read_sparse_model, SparseModel};
 use vgsel_colmap::geometry::similarity::Similarity;
 use vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 
@@ -205,6 +205,27 @@ fn examples<'a>(pairs: impl Iterator<Item = (&'a String, &'a String)>) -> String
         .join(" ")
 }
 
+/// The images the database links and no model registered (none without the database): a line
+/// where there are any, and the list written to `path` (`--unregistered`).
+fn unregistered(
+    evidence: Option<&Evidence>,
+    models: &[SparseModel],
+    path: Option<&Path>,
+) -> Result<Vec<String>> {
+    let names = match evidence {
+        Some(e) => e.unregistered(models, DEFAULT_MIN_NUM_MATCHES),
+        None => Vec::new(),
+    };
+    if !names.is_empty() {
+        println!("{}", unregistered_line(&names));
+    }
+    if let Some(path) = path {
+        let lines: String = names.iter().map(|n| format!("{n}\n")).collect();
+        std::fs::write(path, lines).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(names)
+}
+
 /// The line for images the database links and no model registered (at least one).
 fn unregistered_line(names: &[String]) -> String {
     let shown: Vec<&str> = names.iter().take(5).map(String::as_str).collect();
@@ -299,17 +320,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             .into();
         joined.push(value);
     }
-    let unregistered = match &evidence {
-        Some(e) => e.unregistered(&models, DEFAULT_MIN_NUM_MATCHES),
-        None => Vec::new(),
-    };
-    if !unregistered.is_empty() {
-        println!("{}", unregistered_line(&unregistered));
-    }
-    if let Some(path) = &args.unregistered {
-        let lines: String = unregistered.iter().map(|n| format!("{n}\n")).collect();
-        std::fs::write(path, lines).with_context(|| format!("writing {}", path.display()))?;
-    }
+    let unregistered = unregistered(evidence.as_ref(), &models, args.unregistered.as_deref())?;
     if let Some(path) = &args.report {
         let report = serde_json::json!({
             "ghosted": ghosted,
