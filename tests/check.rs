@@ -70,13 +70,8 @@ fn check_exit_statuses_report_and_plots() {
     assert!(plots.join("top_view_0.svg").is_file());
     // The images left out are the database's to tell.
     let left = dir.path().join("left.txt");
-    let out = vgsel(&[
-        "check",
-        "--model",
-        sparse.to_str().unwrap(),
-        "--unregistered",
-        left.to_str().unwrap(),
-    ]);
+    let (m, l) = (sparse.to_str().unwrap(), left.to_str().unwrap());
+    let out = vgsel(&["check", "--model", m, "--unregistered", l]);
     assert_eq!(out.status.code(), Some(2), "{out:?}");
     assert!(!left.exists());
     let missing = dir.path().join("nothing");
