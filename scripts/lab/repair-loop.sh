@@ -26,10 +26,11 @@ turns=${TURNS:-3}
 # shellcheck source=scripts/lab/demo-matching.sh
 source scripts/lab/demo-matching.sh
 demo_setup "$work"
-map_with() { # MAPPER DB OUT [REPAIR]: COLMAP 3.8's mapper (colmap3.8) or pycolmap's (global,
-  # incremental); REPAIR not empty: a repair turn's run
-  local init=()
-  [ -n "${4:-}" ] && [ -n "${REPAIR_INIT_ANGLE:-}" ] &&
+map_with() { # MAPPER DB OUT STEP: COLMAP 3.8's mapper (colmap3.8) or pycolmap's (global,
+  # incremental); STEP above 1: a repair turn's run
+  local init=() repair=
+  [ "$4" -gt 1 ] && repair=1
+  [ -n "$repair" ] && [ -n "${REPAIR_INIT_ANGLE:-}" ] &&
     init=(--Mapper.init_min_tri_angle "$REPAIR_INIT_ANGLE")
   if [ "$1" = colmap3.8 ]; then
     mkdir -p "$3"
@@ -37,7 +38,7 @@ map_with() { # MAPPER DB OUT [REPAIR]: COLMAP 3.8's mapper (colmap3.8) or pycolm
       "${init[@]}" >"$3.log" 2>&1
     echo '{}' >"$3.json"
     # A repair turn that made a model (with none, COLMAP relaxed its initial pair already).
-    if [ -n "${4:-}" ] && [ "${LEFT_OUT:-1}" = 1 ] && [ -n "$(ls -A "$3")" ]; then
+    if [ -n "$repair" ] && [ "${LEFT_OUT:-1}" = 1 ] && [ -n "$(ls -A "$3")" ]; then
       "$bin" check --model "$3" --database_path "$2" --unregistered "$3.left" >/dev/null ||
         [ $? = 3 ]
       if [ -s "$3.left" ]; then
@@ -71,7 +72,7 @@ for run in $(seq 1 "$runs"); do
       models=()
       for step in $(seq 1 $((turns + 1))); do
         model=$dir/${mapper}_$step
-        map_with "$mapper" "$db" "$model" "${models[*]}"
+        map_with "$mapper" "$db" "$model" "$step"
         score "$model" "$db" >"$model.eval.json"
         status=0
         "$bin" check --model "$model" --database_path "$db" \

@@ -57,10 +57,11 @@ impl Sets {
         Sets((0..n).collect())
     }
 
-    /// Joins the sets of `a` and `b`; false where they were one already.
+    /// Joins the sets of `a` and `b`, under the smaller representative (so that each set's
+    /// representative is its smallest view); false where they were one already.
     pub(super) fn union(&mut self, a: usize, b: usize) -> bool {
         let (ra, rb) = (self.find(a), self.find(b));
-        self.0[ra] = rb;
+        self.0[ra.max(rb)] = ra.min(rb);
         ra != rb
     }
 
@@ -252,10 +253,7 @@ pub fn component_splits(
 ) -> Vec<Vec<bool>> {
     let mut sets = Sets::new(n);
     for &(_, a, b) in edges {
-        let (ra, rb) = (sets.find(a), sets.find(b));
-        if ra != rb {
-            sets.0[ra.max(rb)] = ra.min(rb);
-        }
+        sets.union(a, b);
     }
     let roots: Vec<usize> = (0..n).map(|v| sets.find(v)).collect();
     let mut out = SplitList::default();
