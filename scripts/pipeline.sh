@@ -74,22 +74,16 @@ log "prune $prune_args"
 # The pruned database was just rewritten, so its reconstruction is redone.
 rm -f "$work/sparse_pruned.seconds"
 
-# A repair turn's second mapper run, on the images its database links and its first run left
-# out, into sparse_VARIANT/left (where `check --model` and `prune --model` see it as the same
-# run's); its seconds are added to the turn's.
+# A repair turn's second mapper run (scripts/map-left-out.sh): the images its database links and
+# its first run left out, mapped into sparse_VARIANT/left; its seconds are added to the turn's.
 map_left_out() {
-  local variant=$1 sparse=$work/sparse_$1 left=$work/left_$1.txt seconds
-  # No model at all: COLMAP relaxed its initial pair already.
-  [ -n "$(ls -A "$sparse")" ] || return 0
-  "$bin" check --model "$sparse" --database_path "$work/$variant.db" --unregistered "$left" \
-    >/dev/null || [ $? = 3 ]
-  [ -s "$left" ] || return 0
-  log "mapper on the $(wc -l <"$left") images the $variant model left out"
-  mkdir -p "$sparse/left"
-  seconds=$(timed "$work/mapper_${variant}_left.log" colmap mapper \
-    --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse/left" \
-    --image_list_path "$left" --Mapper.extract_colors 0)
-  echo "$(cat "$sparse.seconds") + $seconds" | bc >"$sparse.seconds"
+  local variant=$1 sparse=$work/sparse_$1 first seconds
+  seconds=$(timed "$work/left_$variant.log" env VGSEL="$bin" "$here/scripts/map-left-out.sh" \
+    "$work/$variant.db" "$images" "$sparse" --Mapper.extract_colors 0)
+  [ -s "$sparse.left.txt" ] &&
+    log "mapper on the $(wc -l <"$sparse.left.txt") images the $variant model left out"
+  first=$(cat "$sparse.seconds")
+  echo "$first + $seconds" | bc >"$sparse.seconds"
 }
 
 # The mapper on one database of WORKDIR (full, pruned or repaired) and the eval of its model.
@@ -111,14 +105,15 @@ map_and_eval() {
 map_and_eval full
 map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds
-last=pruned models=()
-# Every model is checked, the last turn's too; a turn runs where the check gives `prune --model`
-# something to act on (its report's `repair`: pairs a ghost blames, pairs that place a misplaced
-# group or join clean models).
+last=pruned models=() earlier=()
+# Every model is checked, the last turn's too, after the models before it (a clean model's
+# pieces an earlier ghost had put onto each other join); a turn runs where the check gives
+# `prune --model` something to act on (its report's `repair`: pairs a ghost blames, pairs that
+# place a misplaced group or join clean models).
 for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   [ "${REPAIR:-0}" -gt 0 ] || break
   status=0
-  "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" \
+  "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" "${earlier[@]}" \
     --report "$work/check_$last.json" >"$work/check_$last.txt" || status=$?
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
@@ -126,6 +121,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
     "$work/check_$last.json" || break
   [ "$turn" -le "$REPAIR" ] || break
   models+=(--model "$work/sparse_$last")
+  earlier+=(--earlier_model "$work/sparse_$last")
   log "the $last model is ghosted, misplaced or in pieces: prune --model (turn $turn), mapper again"
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \

@@ -5,10 +5,10 @@
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 use vgsel_colmap::eval::render::{Scene, SceneKind};
 
-fn vgsel(args: &[&str]) -> std::process::Output {
+fn vgsel(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
         .args(args)
         .output()
@@ -176,6 +176,82 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
     // The full database ghosts and the pruned one does not, as a rule (tests/e2e.rs): recorded.
     eprintln!("exit statuses full, pruned: {verdicts:?}");
     repair_from_the_full_model(&work, &dir.path().join("images"), &dir.path().join("gt"));
+    left_out_images_are_mapped_on_their_own(&work, &dir.path().join("images"));
+}
+
+/// COLMAP 3.8's mapper on `db` into `out` (created), on the images `list` names or on all.
+fn colmap_mapper(db: &Path, images: &Path, out: &Path, list: Option<&Path>) -> Output {
+    std::fs::create_dir_all(out).unwrap();
+    let mut mapper = Command::new("colmap");
+    mapper.arg("mapper").arg("--database_path").arg(db);
+    mapper
+        .arg("--image_path")
+        .arg(images)
+        .arg("--output_path")
+        .arg(out);
+    if let Some(list) = list {
+        mapper.arg("--image_list_path").arg(list);
+    }
+    mapper.output().expect("running colmap mapper")
+}
+
+/// scripts/map-left-out.sh after a run that left out `left` of the images (the first ones by
+/// name): it prints how many it gave the mapper and lists them; with ten left out it maps
+/// them into SPARSE/left, so that `check --unregistered` lists none; with one left out, which
+/// starts no model (COLMAP 3.8 exits 1 on that), it succeeds and leaves the run as it was.
+fn left_out_images_are_mapped_on_their_own(work: &Path, images: &Path) {
+    let mut names: Vec<String> = std::fs::read_dir(images)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    for left in [10, 1] {
+        let db = work.join(format!("left{left}.db"));
+        std::fs::copy(work.join("full.db"), &db).unwrap();
+        let list = work.join(format!("mapped{left}.txt"));
+        std::fs::write(&list, names[left..].join("\n") + "\n").unwrap();
+        let sparse = work.join(format!("sparse_left{left}"));
+        let mapper = colmap_mapper(&db, images, &sparse, Some(&list));
+        assert!(mapper.status.success(), "{mapper:?}");
+        let out = Command::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scripts/map-left-out.sh"
+        ))
+        .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .arg(&db)
+        .arg(images)
+        .arg(&sparse)
+        .output()
+        .expect("running scripts/map-left-out.sh");
+        assert!(out.status.success(), "{out:?}");
+        // The images the run left out: those not given to it, and any it failed to register.
+        let listed = std::fs::read_to_string(sparse.with_extension("left.txt")).unwrap();
+        let listed: Vec<&str> = listed.lines().collect();
+        assert!(
+            names[..left].iter().all(|n| listed.contains(&n.as_str())),
+            "{listed:?}"
+        );
+        let printed = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(printed.trim(), listed.len().to_string());
+        let models = std::fs::read_dir(sparse.join("left")).unwrap().count();
+        assert_eq!(models > 0, left > 1, "{left} left out: {models} models");
+        if left > 1 {
+            let again = work.join("unregistered_again.txt");
+            let check = vgsel(&[
+                "check",
+                "--model",
+                sparse.to_str().unwrap(),
+                "--database_path",
+                db.to_str().unwrap(),
+                "--unregistered",
+                again.to_str().unwrap(),
+            ]);
+            assert!(matches!(check.status.code(), Some(0 | 3)), "{check:?}");
+            // `check` reads SPARSE/left as part of the run: fewer images are left out now.
+            let again = std::fs::read_to_string(&again).unwrap();
+            assert!(again.lines().count() < listed.len(), "{again}");
+        }
+    }
 }
 
 /// `eval --placements` places every registered image (each has far more than 30
@@ -245,18 +321,7 @@ fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
         .concat(),
     );
     assert!(out.status.success(), "{out:?}");
-    std::fs::create_dir_all(&model).unwrap();
-    let mapper = Command::new("colmap")
-        .args([
-            "mapper",
-            "--database_path",
-            &s(&repaired),
-            "--image_path",
-            &s(images),
-        ])
-        .args(["--output_path", &s(&model)])
-        .output()
-        .expect("running colmap mapper");
+    let mapper = colmap_mapper(&repaired, images, &model, None);
     assert!(mapper.status.success(), "{mapper:?}");
     let eval = vgsel(&["eval", "--model", &s(&model), "--ground_truth", &s(gt)]);
     let eval: Value = serde_json::from_slice(&eval.stdout).unwrap();

@@ -24,7 +24,8 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; `repair`:
             the repair loop after the `disambiguation` run of the same variant, order and mapper:
             `check` its model, and where it is ghosted `prune --model` with every model so far
-            and map once more, at most REPAIR_TURNS times, else that run stands); --order, default image_id; mapper colmap3.8
+            and map once more, at most REPAIR_TURNS times, else that run stands; with COLMAP
+            3.8 each turn also maps the images it left out, scripts/map-left-out.sh); --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).
 
@@ -102,6 +103,21 @@ def mapper(db, images, out):
         outcome="failed to create sparse model")
     os.remove(copy)
     open(out + ".done", "w").close()
+
+
+def map_left_out(db, images, out):
+    """A repair turn's second `colmap mapper` run (scripts/map-left-out.sh, as the README's
+    recipe and pipeline.sh have it): the images db links and out/ left out, into out/left, on a
+    copy of db, unless done before."""
+    if os.path.exists(out + ".left.done"):
+        return
+    copy = out + ".left.db"
+    shutil.copyfile(db, copy)
+    log(f"colmap mapper on the images {out} left out")
+    run(["env", f"VGSEL={VGSEL}", os.path.join(ROOT, "scripts", "map-left-out.sh"), copy, images,
+         out, "--Mapper.extract_colors", "0"])
+    os.remove(copy)
+    open(out + ".left.done", "w").close()
 
 
 @functools.lru_cache(maxsize=None)
@@ -302,9 +318,10 @@ def scored_run(images, work, dbs, spec):
         result, models = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}"), []
         for turn in range(1, REPAIR_TURNS + 1):
             report = result["sparse"] + ".check.json"
+            earlier = ["--earlier_model" if a == "--model" else a for a in models]
             checked = subprocess.run([VGSEL, "check", "--model", result["sparse"],
-                                      "--database_path", result["database"], "--report", report],
-                                     capture_output=True)
+                                      "--database_path", result["database"], *earlier,
+                                      "--report", report], capture_output=True)
             if checked.returncode not in (0, 3):
                 sys.exit(f"lab-measure: check failed on {result['sparse']}: "
                          f"{checked.stderr.decode()}")
@@ -340,6 +357,8 @@ def measured(images, work, db, variant, order, kind, extra, listed, tag, preset,
         r = json.load(open(report))
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
+    if loop and kind != "global":
+        map_left_out(pruned, images, sparse)
     txt = os.path.join(work, "truth_txt")
     model = any(d.isdigit() for d in os.listdir(sparse)) if os.path.isdir(sparse) else False
     # No model: the pairs are still counted (the reference stands in for the model).

@@ -13,7 +13,7 @@
 # initial-pair angle in the repair turns (--Mapper.init_min_tri_angle) [COLMAP's own, 16]; the
 # first mapper run keeps COLMAP's defaults. 8 was measured and not adopted (docs/check.md).
 # LEFT_OUT: in a repair turn with COLMAP 3.8, map the images the database links and the run left
-# out on their own into the turn's folder (`check --unregistered`, as the README says) [1]; 0:
+# out on their own into the turn's folder (scripts/map-left-out.sh, as the README says) [1]; 0:
 # not (the loop before session 23).
 # usage: scripts/lab/repair-loop.sh [WORKDIR] [RUNS] [MAPPERS]
 #        (defaults: target/repair-loop, 5, "global incremental")
@@ -37,15 +37,8 @@ map_with() { # MAPPER DB OUT STEP: COLMAP 3.8's mapper (colmap3.8) or pycolmap's
     nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3" \
       "${init[@]}" >"$3.log" 2>&1
     echo '{}' >"$3.json"
-    # A repair turn that made a model (with none, COLMAP relaxed its initial pair already).
-    if [ -n "$repair" ] && [ "${LEFT_OUT:-1}" = 1 ] && [ -n "$(ls -A "$3")" ]; then
-      "$bin" check --model "$3" --database_path "$2" --unregistered "$3.left" >/dev/null ||
-        [ $? = 3 ]
-      if [ -s "$3.left" ]; then
-        mkdir -p "$3/left"
-        nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3/left" \
-          --image_list_path "$3.left" "${init[@]}" >"$3.left.log" 2>&1
-      fi
+    if [ -n "$repair" ] && [ "${LEFT_OUT:-1}" = 1 ]; then
+      VGSEL=$bin nice scripts/map-left-out.sh "$2" "$images" "$3" "${init[@]}" >/dev/null
     fi
   else
     nice "$PY" scripts/ci/colmap4.py map "$1" "$2" "$images" "$3" >"$3.json" 2>"$3.log"
@@ -75,7 +68,7 @@ for run in $(seq 1 "$runs"); do
         map_with "$mapper" "$db" "$model" "$step"
         score "$model" "$db" >"$model.eval.json"
         status=0
-        "$bin" check --model "$model" --database_path "$db" \
+        "$bin" check --model "$model" --database_path "$db" "${models[@]/#--model/--earlier_model}" \
           --report "$model.check.json" >"$model.check.txt" || status=$?
         [ "$status" -eq 0 ] || [ "$status" -eq 3 ] || exit "$status"
         # Another turn where the check gives `prune --model` something to act on.

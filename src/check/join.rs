@@ -17,7 +17,11 @@
 //! the check cannot see (copies that share their surroundings), and nothing tells it from a
 //! true one. Measured on the peers' multi-model outputs (docs/check.md): joining the strongest
 //! clean placement, 36 of 57 joins were wrong; any clean placement after any refuted one, 6 of
-//! 12 (a wrong placement conflicts too, however weak).
+//! 12 (a wrong placement conflicts too, however weak). An earlier run of the repair loop can
+//! have refuted that stronger placement already: a model of it that was ghosted between the two
+//! models' images ([`Glued`]). The check saw that scene's ghost, so it can see its ghosts, and
+//! the strongest clean placement joins (streets whose repair left two correct models, the
+//! ghost's placement no longer the strongest once each copy is a model of its own).
 
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
@@ -82,7 +86,8 @@ pub struct Join {
     pub placement: Placement,
     /// Correspondences that agree with the placement.
     pub support: usize,
-    /// Stronger placements the check called ghosted (at least one: see the module's doc).
+    /// Stronger placements the check called ghosted (at least one: see the module's doc),
+    /// earlier runs' ghosts that put the two models onto each other included.
     pub refuted: usize,
     /// The conflicts of the two models put together, one group each.
     pub counts: Counts,
@@ -125,15 +130,40 @@ impl From<&Similarity> for Placement {
     }
 }
 
+/// The two groups of images an earlier run's ghosted model put onto each other (its worst
+/// split): its placement of one group in the other's frame conflicted. Two models of a later
+/// run that lie on its two sides were placed so once already, and refuted.
+pub type Glued = [Vec<String>; 2];
+
+/// The side of `glued` (0 or 1) that holds more than half of `model`'s images, if one does.
+fn side(model: &SparseModel, glued: &Glued) -> Option<usize> {
+    let on = |g: &Vec<String>| {
+        let n = model.images.iter().filter(|im| g.contains(&im.image.name));
+        2 * n.count() > model.images.len()
+    };
+    (0..2).find(|&k| on(&glued[k]))
+}
+
+/// How many of the earlier runs' ghosts put `a` and `b` onto each other: each lies on its own
+/// side of the ghost's split.
+fn refuted_earlier(a: &SparseModel, b: &SparseModel, earlier: &[Glued]) -> usize {
+    earlier
+        .iter()
+        .filter(|g| matches!((side(a, g), side(b, g)), (Some(x), Some(y)) if x != y))
+        .count()
+}
+
 /// One correspondence: the second model's point, the first's, and the database pair it is from.
 type Correspondence = (Vector3<f64>, Vector3<f64>, usize);
 
 /// The joins among `models` (each with its check's verdict: ghosted models are not joined).
-/// Each pair of clean models with at least `min_group` images each is tried.
+/// Each pair of clean models with at least `min_group` images each is tried; the `earlier`
+/// runs' ghosts that put the two onto each other count as refuted placements.
 pub fn join_models(
     models: &[(&SparseModel, bool)],
     evidence: &Evidence,
     settings: &CheckSettings,
+    earlier: &[Glued],
 ) -> anyhow::Result<Vec<Join>> {
     let mut joins = Vec::new();
     let usable = |m: &(&SparseModel, bool)| !m.1 && m.0.images.len() >= settings.min_group;
@@ -141,7 +171,8 @@ pub fn join_models(
         for b in a + 1..models.len() {
             if usable(&models[a]) && usable(&models[b]) {
                 let pair = [models[a].0, models[b].0];
-                joins.extend(join_two([a, b], pair, evidence, settings, 0)?);
+                let refuted = refuted_earlier(pair[0], pair[1], earlier);
+                joins.extend(join_two([a, b], pair, evidence, settings, refuted)?);
             }
         }
     }
@@ -211,7 +242,7 @@ fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
 
 /// The join of models `[a, b]` (their indices `models`): the first placement of `b` in `a`'s
 /// frame that does not conflict, if a stronger one did; `refuted` counts placements refuted
-/// before any is tried (a ghost's own).
+/// before any is tried (a ghost's own, or earlier runs' ghosts').
 fn join_two(
     models: [usize; 2],
     [a, b]: [&SparseModel; 2],

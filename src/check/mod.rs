@@ -440,11 +440,13 @@ pub struct RunCheck<'e> {
 }
 
 /// Checks every model of one mapper run and, with `evidence`, places the two groups of each
-/// clean one ([`join::place_group`]) and joins the models still clean.
+/// clean one ([`join::place_group`]) and joins the models still clean (`earlier`: the ghosts
+/// of the repair loop's earlier runs, [`RunCheck::glued`]).
 pub fn check_run<'e>(
     models: &[SparseModel],
     evidence: Option<&'e Evidence>,
     settings: &CheckSettings,
+    earlier: &[join::Glued],
 ) -> Result<RunCheck<'e>> {
     let mut checks = models
         .iter()
@@ -492,7 +494,7 @@ pub fn check_run<'e>(
                 .iter()
                 .zip(checks.iter().map(ModelCheck::wrong))
                 .collect();
-            join::join_models(&checked, e, settings)?
+            join::join_models(&checked, e, settings, earlier)?
         }
         None => Vec::new(),
     };
@@ -503,6 +505,20 @@ pub fn check_run<'e>(
 }
 
 impl RunCheck<'_> {
+    /// The groups each ghost of this run put onto each other, for the joins of a later run
+    /// ([`join::Glued`]): ghosts of two groups, not of misplaced images.
+    pub fn glued(&self) -> Vec<join::Glued> {
+        let ghosts = self
+            .models
+            .iter()
+            .filter(|c| c.ghosted && !c.ghost_of_images);
+        ghosts
+            .flat_map(|c| &c.worst)
+            .filter(|w| !w.alone())
+            .map(|w| w.groups.clone())
+            .collect()
+    }
+
     /// What `prune --model` takes from this run: the blamed pairs of its ghosted models, and
     /// the pairs linking the clean models it joins, the groups it found misplaced and the
     /// ghosts' second groups where the matches place them (kept over the blame). Empty
@@ -653,17 +669,20 @@ fn blames(p: &JoiningPair, alone: bool) -> bool {
 }
 
 /// The repair's evidence from the models of `dir` (a model folder or a mapper's output_path),
-/// checked with the database's `evidence`.
+/// checked with the database's `evidence` after the `earlier` runs' ghosts, and the ghosts of
+/// its own ([`RunCheck::glued`]) for a later run's.
 pub fn model_evidence(
     dir: &std::path::Path,
     evidence: &Evidence,
     settings: &CheckSettings,
-) -> Result<ModelEvidence> {
+    earlier: &[join::Glued],
+) -> Result<(ModelEvidence, Vec<join::Glued>)> {
     let models = crate::colmap::model::model_dirs(dir)?
         .iter()
         .map(|d| crate::colmap::sparse::read_sparse_model(d))
         .collect::<Result<Vec<_>>>()?;
-    Ok(check_run(&models, Some(evidence), settings)?.evidence())
+    let run = check_run(&models, Some(evidence), settings, earlier)?;
+    Ok((run.evidence(), run.glued()))
 }
 
 #[cfg(test)]

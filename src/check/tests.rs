@@ -295,6 +295,7 @@ fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
         std::slice::from_ref(&model),
         Some(&evidence),
         &DEFAULT_SETTINGS,
+        &[],
     )
     .unwrap();
     assert!(run.models[0].ghosted, "score {}", run.models[0].score);
@@ -657,6 +658,40 @@ fn two_models_are_not_joined_without_a_refuted_ghost() {
     assert!(joins.is_empty(), "{joins:?}");
 }
 
+/// The same two models after a repair turn whose ghost had put them onto each other (an
+/// earlier run's model, ghosted between images 1-6 and 7-12): that placement was refuted
+/// already, so their one placement without conflict joins them. A ghost between other groups
+/// (each model on both of its sides) refutes nothing of theirs.
+#[test]
+fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
+    let (a, b) = two_models(
+        &correct_model(),
+        |im| im.image.image_id > 6,
+        100_000,
+        &elsewhere(),
+    );
+    let evidence = matches_between(&a, &b, 100_000);
+    let names = |m: &SparseModel| m.images.iter().map(|im| im.image.name.clone()).collect();
+    let glued: join::Glued = [names(&a), names(&b)];
+    let pair = [(&a, false), (&b, false)];
+    let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[glued]).unwrap();
+    assert_eq!(joins.len(), 1, "{joins:?}");
+    assert_eq!(joins[0].refuted, 1);
+    assert!(!joins[0].links.is_empty());
+    let (p, back) = (&joins[0].placement, back_from_elsewhere());
+    assert!((p.scale - back.scale).abs() < 1e-6 * back.scale, "{p:?}");
+    let odd = |m: &SparseModel, k| {
+        let images = m.images.iter().filter(|im| im.image.image_id % 2 == k);
+        images.map(|im| im.image.name.clone()).collect::<Vec<_>>()
+    };
+    let across = [
+        [odd(&a, 0), odd(&b, 0)].concat(),
+        [odd(&a, 1), odd(&b, 1)].concat(),
+    ];
+    let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[across]).unwrap();
+    assert!(joins.is_empty(), "{joins:?}");
+}
+
 /// The ghosted model's two walls as two models: their matches (on the shared object) place
 /// one wall's cameras onto the other's, which conflicts, and nothing else places them.
 #[test]
@@ -670,7 +705,13 @@ fn two_copies_matched_on_their_repeated_object_are_not_joined() {
 fn joins_of_a_split(model: &SparseModel, in_b: impl Fn(&SparseImage) -> bool) -> Vec<join::Join> {
     let (a, b) = two_models(model, in_b, 100_000, &elsewhere());
     let evidence = matches_between(&a, &b, 100_000);
-    join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap()
+    join::join_models(
+        &[(&a, false), (&b, false)],
+        &evidence,
+        &DEFAULT_SETTINGS,
+        &[],
+    )
+    .unwrap()
 }
 
 const HALL_OFFSET: u64 = 100_000;
@@ -741,8 +782,13 @@ fn back_from_elsewhere() -> Similarity {
 #[test]
 fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_refuted() {
     let (a, b, evidence) = hall_like();
-    let joins =
-        join::join_models(&[(&a, false), (&b, false)], &evidence, &DEFAULT_SETTINGS).unwrap();
+    let joins = join::join_models(
+        &[(&a, false), (&b, false)],
+        &evidence,
+        &DEFAULT_SETTINGS,
+        &[],
+    )
+    .unwrap();
     assert_eq!(joins.len(), 1, "{joins:?}");
     let join = &joins[0];
     assert_eq!(join.refuted, 1);
@@ -782,7 +828,7 @@ fn a_group_the_database_places_elsewhere_is_misplaced() {
     };
     for (placement, misplaced) in [(back_from_elsewhere(), false), (wrong, true)] {
         let one = join::put_together(&a, &b, &placement).0;
-        let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+        let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
         let c = &run.models[0];
         assert!(!c.ghosted, "score {}", c.score);
         assert_eq!(c.misplaced.is_some(), misplaced, "{:?}", c.misplaced);
@@ -817,7 +863,7 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
         translation: back_from_elsewhere().translation - Vector3::new(5.0, 0.0, 0.0),
     };
     let one = join::put_together(&a, &b, &fold).0;
-    let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
     let c = &run.models[0];
     assert!(c.ghosted, "score {}", c.score);
     assert!(c.misplaced.is_none());
@@ -868,7 +914,7 @@ fn with_shift(shift: f64) -> (SparseModel, Evidence) {
 #[test]
 fn an_image_its_matches_place_elsewhere_is_misplaced() {
     let (model, evidence) = with_shift(0.0);
-    let in_place = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let in_place = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
     assert!(in_place.models[0].misplaced_images.is_empty());
     assert!(!in_place.models[0].wrong());
     // Every image is placed, where the model has it.
@@ -877,7 +923,7 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     assert_eq!(placed.len(), views.views.len());
     assert!(placed.iter().all(|p| p.moved < 0.01), "{placed:?}");
     let (model, evidence) = with_shift(1.0);
-    let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
     let c = &run.models[0];
     assert!(!c.ghosted, "score {}", c.score);
     assert!(c.wrong());
@@ -897,7 +943,7 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     // Eight units off (about four times the spread) is a jump, not a correction: not called
     // so.
     let (model, evidence) = with_shift(8.0);
-    let far = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let far = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
     assert!(far.models[0].misplaced_images.is_empty());
     let placed = resection::image_placements(far.models[0].views.as_ref().unwrap()).unwrap();
     let p = placed.iter().find(|p| p.image == "0005.png").unwrap();
@@ -908,7 +954,7 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     for p in &mut model.images[4].points2d {
         p.point3d_id = None;
     }
-    let bare = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    let bare = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
     assert_eq!(bare.models[0].unanchored, ["0005.png"]);
     assert!(bare.models[0].misplaced_images.is_empty());
 }
@@ -1064,6 +1110,7 @@ fn refused_of(model: &SparseModel, evidence: &Evidence) -> (bool, Vec<[String; 2
         std::slice::from_ref(model),
         Some(evidence),
         &DEFAULT_SETTINGS,
+        &[],
     )
     .unwrap();
     let c = &run.models[0];
@@ -1156,7 +1203,7 @@ fn only_matches_far_from_the_matches_pose_hold_a_misplaced_image() {
             });
             matches.push([first + n as u32, *k]);
         }
-        let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+        let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
         let [m] = &run.models[0].misplaced_images[..] else {
             panic!("{:?}", run.models[0].misplaced_images)
         };

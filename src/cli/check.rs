@@ -39,6 +39,12 @@ pub struct CheckArgs {
     /// with COLMAP 3.8, a repair turn maps them on their own into DIR/left (README).
     #[arg(long, value_name = "FILE", requires = "database_path")]
     unregistered: Option<PathBuf>,
+    /// The repair loop's earlier mapper output folders on this database, in the order they ran
+    /// (repeatable, as `prune --model` takes them): where a model of theirs was ghosted between
+    /// two clean models of this run, it placed one in the other's frame and that was refuted, so
+    /// their strongest placement without conflict joins them.
+    #[arg(long, value_name = "DIR", requires = "database_path")]
+    earlier_model: Vec<PathBuf>,
     /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = super::args::fraction)]
     threshold: f64,
@@ -226,6 +232,24 @@ fn unregistered(
     Ok(names)
 }
 
+/// The ghosts of the `--earlier_model` folders, each checked after the ones before it (as
+/// `prune --model` checks its folders).
+fn earlier_ghosts(
+    dirs: &[PathBuf],
+    evidence: Option<&Evidence>,
+    settings: &CheckSettings,
+) -> Result<Vec<check::join::Glued>> {
+    let mut earlier = Vec::new();
+    if let Some(evidence) = evidence {
+        for dir in dirs {
+            let (_, glued) = check::model_evidence(dir, evidence, settings, &earlier)
+                .with_context(|| format!("checking --earlier_model {}", dir.display()))?;
+            earlier.extend(glued);
+        }
+    }
+    Ok(earlier)
+}
+
 /// The line for images the database links and no model registered (at least one).
 fn unregistered_line(names: &[String]) -> String {
     let shown: Vec<&str> = names.iter().take(5).map(String::as_str).collect();
@@ -291,7 +315,8 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
         .collect::<Result<Vec<_>>>()?;
     let images: usize = models.iter().map(|m| m.images.len()).sum();
     progress.stage(&format!("checking {images} registered images"));
-    let run = check::check_run(&models, evidence.as_ref(), &settings)?;
+    let earlier = earlier_ghosts(&args.earlier_model, evidence.as_ref(), &settings)?;
+    let run = check::check_run(&models, evidence.as_ref(), &settings, &earlier)?;
     progress.finish();
     let mut reports = Vec::new();
     for (k, (dir, result)) in dirs.iter().zip(&run.models).enumerate() {

@@ -196,9 +196,14 @@ impl Parameters {
         if !rules.model.is_empty() {
             // The database's side of the check, read once for every --model folder.
             let evidence = check::evidence::Evidence::load(db)?;
+            // The ghosts of the folders before: a later run's clean models they put onto each
+            // other join by the strongest clean placement (check::join).
+            let mut earlier = Vec::new();
             for dir in &rules.model {
-                let found = check::model_evidence(dir, &evidence, &check::DEFAULT_SETTINGS)
+                let settings = &check::DEFAULT_SETTINGS;
+                let (found, glued) = check::model_evidence(dir, &evidence, settings, &earlier)
                     .with_context(|| format!("checking --model {}", dir.display()))?;
+                earlier.extend(glued);
                 let list = |pairs: Vec<[String; 2]>| NameList {
                     path: dir.to_path_buf(),
                     entries: pairs

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# A repair turn's second run of COLMAP 3.8's mapper (README, "Is the model ghosted?"): the images
+# the database links (a pair of 15 inliers or more) and no model of SPARSE registered, mapped on
+# their own into SPARSE/left, where `check --model`, `eval` and `prune --model` read them as part
+# of the same run. COLMAP 3.8 relaxes its initial pair only while it has no model at all, so a
+# piece that `prune --model` cut off and whose neighbours see their surroundings under small
+# angles starts no model of its own (docs/check.md, "Pieces that start no model"). COLMAP 4
+# needs none of this: its incremental mapper relaxes while images are left, its global mapper
+# has no initial pair.
+#
+# usage: scripts/map-left-out.sh DB IMAGES SPARSE [MAPPER_OPTION ...]
+#   DB       the database the turn's mapper ran on
+#   IMAGES   the image folder
+#   SPARSE   the turn's mapper output folder; nothing is done where it holds no model (COLMAP
+#            relaxed its initial pair already) or where every linked image is registered
+#   MAPPER_OPTION  more `colmap mapper` options, as the turn's first run had them
+# Writes SPARSE.left.txt (the images, one name a line) and, where it maps, SPARSE.left.log.
+# Prints how many images it gave the mapper. Environment: VGSEL, the vgsel-colmap binary
+# [vgsel-colmap on PATH].
+set -euo pipefail
+[ $# -ge 3 ] || { sed -n '11,20p' "$0" >&2; exit 2; }
+db=$1 images=$2 sparse=$3
+shift 3
+bin=${VGSEL:-vgsel-colmap}
+list=$sparse.left.txt
+rm -f "$list"
+if [ -z "$(ls -A "$sparse" 2>/dev/null)" ]; then
+  echo 0
+  exit 0
+fi
+# Exit 3 is the model's verdict (ghosted, misplaced or unanchored), not a failure.
+"$bin" check --model "$sparse" --database_path "$db" --unregistered "$list" >/dev/null ||
+  [ $? = 3 ]
+if [ ! -s "$list" ]; then
+  echo 0
+  exit 0
+fi
+mkdir -p "$sparse/left"
+# COLMAP 3.8 exits 1 where the images start no model (one image alone, or no initial pair even
+# relaxed): the run then stays as it was.
+if ! colmap mapper --database_path "$db" --image_path "$images" --output_path "$sparse/left" \
+  --image_list_path "$list" "$@" >"$sparse.left.log" 2>&1 &&
+  ! grep -q "failed to create sparse model" "$sparse.left.log"; then
+  tail -n 20 "$sparse.left.log" >&2
+  echo "map-left-out: colmap mapper failed (log: $sparse.left.log)" >&2
+  exit 1
+fi
+wc -l <"$list"
