@@ -74,6 +74,9 @@ fn check_exit_statuses_report_and_plots() {
     let out = vgsel(&["check", "--model", m, "--unregistered", l]);
     assert_eq!(out.status.code(), Some(2), "{out:?}");
     assert!(!left.exists());
+    // So are the earlier runs' ghosts (their placements are the database's matches).
+    let out = vgsel(&["check", "--model", m, "--earlier_model", m]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
     let missing = dir.path().join("nothing");
     let out = vgsel(&["check", "--model", missing.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1), "{out:?}");
