@@ -68,6 +68,7 @@ for run in $(seq 1 "$runs"); do
         map_with "$mapper" "$db" "$model" "$step"
         score "$model" "$db" >"$model.eval.json"
         status=0
+        # The earlier turns' models (the list `prune --model` gets) as --earlier_model.
         "$bin" check --model "$model" --database_path "$db" "${models[@]/#--model/--earlier_model}" \
           --report "$model.check.json" >"$model.check.txt" || status=$?
         [ "$status" -eq 0 ] || [ "$status" -eq 3 ] || exit "$status"
