@@ -22,7 +22,7 @@ pub mod splits;
 pub mod views;
 
 use crate::colmap::sparse::SparseModel;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use conflict::Counts;
 use evidence::Evidence;
 use rayon::prelude::*;
@@ -668,21 +668,31 @@ fn blames(p: &JoiningPair, alone: bool) -> bool {
     p.shared_points > 0 && (!alone || p.matches_joined >= p.matches_apart)
 }
 
-/// The repair's evidence from the models of `dir` (a model folder or a mapper's output_path),
-/// checked with the database's `evidence` after the `earlier` runs' ghosts, and the ghosts of
-/// its own ([`RunCheck::glued`]) for a later run's.
-pub fn model_evidence(
-    dir: &std::path::Path,
+/// The repair's evidence from the repair loop's runs `dirs` (model folders or mappers'
+/// output_paths, in the order they ran; `option` names them in errors), each checked with the
+/// database's `evidence` after the ghosts of the runs before it ([`RunCheck::glued`]): each
+/// run's evidence, and the ghosts of them all for a later run's joins.
+pub fn loop_evidence(
+    dirs: &[std::path::PathBuf],
+    option: &str,
     evidence: &Evidence,
     settings: &CheckSettings,
-    earlier: &[join::Glued],
-) -> Result<(ModelEvidence, Vec<join::Glued>)> {
-    let models = crate::colmap::model::model_dirs(dir)?
-        .iter()
-        .map(|d| crate::colmap::sparse::read_sparse_model(d))
-        .collect::<Result<Vec<_>>>()?;
-    let run = check_run(&models, Some(evidence), settings, earlier)?;
-    Ok((run.evidence(), run.glued()))
+) -> Result<(Vec<ModelEvidence>, Vec<join::Glued>)> {
+    let read = |dir: &std::path::Path| -> Result<Vec<SparseModel>> {
+        let dirs = crate::colmap::model::model_dirs(dir)?;
+        dirs.iter()
+            .map(|d| crate::colmap::sparse::read_sparse_model(d))
+            .collect()
+    };
+    let (mut found, mut earlier) = (Vec::new(), Vec::new());
+    for dir in dirs {
+        let run = read(dir)
+            .and_then(|models| check_run(&models, Some(evidence), settings, &earlier))
+            .with_context(|| format!("checking {option} {}", dir.display()))?;
+        found.push(run.evidence());
+        earlier.extend(run.glued());
+    }
+    Ok((found, earlier))
 }
 
 #[cfg(test)]

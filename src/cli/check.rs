@@ -239,15 +239,10 @@ fn earlier_ghosts(
     evidence: Option<&Evidence>,
     settings: &CheckSettings,
 ) -> Result<Vec<check::join::Glued>> {
-    let mut earlier = Vec::new();
-    if let Some(evidence) = evidence {
-        for dir in dirs {
-            let (_, glued) = check::model_evidence(dir, evidence, settings, &earlier)
-                .with_context(|| format!("checking --earlier_model {}", dir.display()))?;
-            earlier.extend(glued);
-        }
+    match evidence {
+        Some(e) => Ok(check::loop_evidence(dirs, "--earlier_model", e, settings)?.1),
+        None => Ok(Vec::new()),
     }
-    Ok(earlier)
 }
 
 /// The line for images the database links and no model registered (at least one).

@@ -16,7 +16,7 @@ use crate::selection::arc_rules::{ArcRules, ModelFolder, NameList, Overrides};
 use crate::selection::capture_order::{self, Order};
 use crate::selection::preset::Preset;
 use crate::selection::track_completion::Needs;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -196,14 +196,9 @@ impl Parameters {
         if !rules.model.is_empty() {
             // The database's side of the check, read once for every --model folder.
             let evidence = check::evidence::Evidence::load(db)?;
-            // The ghosts of the folders before: a later run's clean models they put onto each
-            // other join by the strongest clean placement (check::join).
-            let mut earlier = Vec::new();
-            for dir in &rules.model {
-                let settings = &check::DEFAULT_SETTINGS;
-                let (found, glued) = check::model_evidence(dir, &evidence, settings, &earlier)
-                    .with_context(|| format!("checking --model {}", dir.display()))?;
-                earlier.extend(glued);
+            let settings = &check::DEFAULT_SETTINGS;
+            let (found, _) = check::loop_evidence(&rules.model, "--model", &evidence, settings)?;
+            for (dir, found) in rules.model.iter().zip(found) {
                 let list = |pairs: Vec<[String; 2]>| NameList {
                     path: dir.to_path_buf(),
                     entries: pairs
