@@ -256,15 +256,18 @@ pub const ANCHORED_FRACTION: f64 = 0.03;
 
 /// The registered images of a model with points that observe no point, or points for under
 /// [`ANCHORED_FRACTION`] of their matched keypoints: the mapper registered them, then dropped
-/// (nearly) every observation as inconsistent with the pose. A model without any point (a
-/// ground truth's poses) anchors nothing and claims nothing.
+/// (nearly) every observation as inconsistent with the pose. A model without any point claims
+/// no structure: alone (a ground truth's poses) it anchors nothing; with the database, its
+/// images matched to each other are unanchored (COLMAP 3.8 writes such a model when bundle
+/// adjustment filtered every point of a failed start).
 fn unanchored(views: &Views) -> Vec<String> {
-    if views.points.is_empty() {
-        return Vec::new();
-    }
     let matched = views.matched_keypoints();
+    let pointless = views.points.is_empty();
     let mut names: Vec<String> = (0..views.views.len())
         .filter(|&v| {
+            if pointless {
+                return matched[v] > 0;
+            }
             let needed = (ANCHORED_FRACTION * matched[v] as f64).max(1.0);
             (views.seen_by[v].len() as f64) < needed
         })

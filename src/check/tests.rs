@@ -444,6 +444,30 @@ fn an_image_the_model_keeps_next_to_no_point_of_is_unanchored() {
     assert!(unanchored_keeping(20).is_empty());
 }
 
+/// A model whose every point was filtered (COLMAP 3.8 writes one after a failed start): alone,
+/// poses without structure, it is judged on nothing; with the database, the images matched to
+/// each other are unanchored and the model wrong, an image without a match in it is not.
+#[test]
+fn a_model_without_points_is_unanchored_where_the_database_matched_its_images() {
+    let mut model = correct_model();
+    let mut evidence = Evidence::default();
+    for (a, b) in [(0, 1), (1, 2)] {
+        let m = matches_of(&model.images[a], &model.images[b], |id| id);
+        let key = (
+            model.images[a].image.name.clone(),
+            model.images[b].image.name.clone(),
+        );
+        evidence.matches.insert(key, m);
+    }
+    model.points.clear();
+    (model.images.iter_mut().flat_map(|i| i.points2d.iter_mut())).for_each(|p| p.point3d_id = None);
+    let alone = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
+    assert!(alone.unanchored.is_empty() && !alone.wrong());
+    let check = check_model(&model, Some(&evidence), &DEFAULT_SETTINGS).unwrap();
+    assert_eq!(check.unanchored, ["0001.png", "0002.png", "0003.png"]);
+    assert!(check.wrong());
+}
+
 #[test]
 fn the_check_is_deterministic() {
     let a = check_model(&ghosted_model(), None, &DEFAULT_SETTINGS).unwrap();
