@@ -73,8 +73,8 @@ impl Split {
     }
 }
 
-/// The check of one model.
-#[derive(Clone, Debug, Serialize)]
+/// The check of one model (the default: no image, nothing found).
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct ModelCheck<'e> {
     /// Registered images.
     pub images: usize,
@@ -106,9 +106,9 @@ pub struct ModelCheck<'e> {
     /// images are the ghost, not its groups (a street's camera one building off, taken for a
     /// split of 16 against 28 images), and the repair acts on them alone.
     pub ghost_of_images: bool,
-    /// Registered images of a model that has points whose poses rest on (next to) nothing it
-    /// holds: no point, or points for under [`ANCHORED_FRACTION`] of their matched keypoints;
-    /// sorted.
+    /// Registered images whose poses rest on (next to) nothing the model holds: no point, or
+    /// points for under [`ANCHORED_FRACTION`] of their matched keypoints; in a model without
+    /// any point, those the database matched to each other. Sorted.
     pub unanchored: Vec<String>,
     /// For a wrong model (ghosted, or placing a group or images elsewhere), the pairs inside
     /// the groups it placed consistently whose matches it holds apart

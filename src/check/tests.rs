@@ -1032,11 +1032,7 @@ fn ghost_of_two(
         }),
         misplaced_images: images,
         ghost_of_images: of_images,
-        unanchored: Vec::new(),
-        refused: Vec::new(),
-        side: Vec::new(),
-        weakest_link: None,
-        views: None,
+        ..ModelCheck::default()
     }
 }
 

@@ -369,8 +369,6 @@ mod tests {
             images: 6,
             points: 10,
             splits_scored: 1,
-            ghosted: false,
-            score: 0.0,
             worst: Some(Split {
                 groups: [names(3), names(3)],
                 counts: Counts {
@@ -382,15 +380,7 @@ mod tests {
                 score: 0.0,
                 joining_pairs: Vec::new(),
             }),
-            misplaced: None,
-            ghost_placement: None,
-            misplaced_images: Vec::new(),
-            ghost_of_images: false,
-            unanchored: Vec::new(),
-            refused: Vec::new(),
-            side: Vec::new(),
-            weakest_link: None,
-            views: None,
+            ..ModelCheck::default()
         }
     }
 
