@@ -121,8 +121,12 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         "clean" => "clean".to_string(),
         wrong => wrong.to_uppercase(),
     };
-    let mut line = format!("{}: {what} (score {:.2}", dir.display(), c.score);
-    if let Some(w) = &c.worst {
+    // A model without points (a failed start) was judged on nothing: no score to give.
+    let mut line = match c.points {
+        0 => format!("{}: {what} (no 3D point", dir.display()),
+        _ => format!("{}: {what} (score {:.2}", dir.display(), c.score),
+    };
+    if let Some(w) = c.worst.as_ref().filter(|_| c.points > 0) {
         let judged = w.counts.conflicting + w.counts.agreeing;
         line += &format!(
             ", {} conflicting of {judged} judged; groups of {} and {} images",
@@ -382,6 +386,21 @@ mod tests {
             }),
             ..ModelCheck::default()
         }
+    }
+
+    /// A model without points says so instead of a score and groups it never judged.
+    #[test]
+    fn a_model_without_points_is_said_to_have_none() {
+        let c = ModelCheck {
+            points: 0,
+            unanchored: vec!["0.png".into(), "1.png".into()],
+            ..checked(0, 0)
+        };
+        assert_eq!(
+            verdict_line(Path::new("sparse/0"), &c, 30),
+            "sparse/0: UNANCHORED (no 3D point; 2 images registered on (next to) no 3D point: \
+             0.png 1.png)"
+        );
     }
 
     /// A clean verdict on fewer judged samples than a ghost needs conflicts says so; one on
