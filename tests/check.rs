@@ -58,6 +58,7 @@ fn check_exit_statuses_report_and_plots() {
     assert_eq!(value["ghosted"], false);
     assert_eq!(value["misplaced"], false);
     assert_eq!(value["unanchored"], false);
+    assert_eq!(value["folded"], false);
     assert_eq!(value["models"][0]["unanchored"], serde_json::json!([]));
     assert_eq!(value["models"][0]["misplaced"], Value::Null);
     assert_eq!(value["models"][0]["ghost_placement"], Value::Null);
@@ -76,6 +77,9 @@ fn check_exit_statuses_report_and_plots() {
     assert!(!left.exists());
     // So are the earlier runs' ghosts (their placements are the database's matches).
     let out = vgsel(&["check", "--model", m, "--earlier_model", m]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    // And the capture order's pairs.
+    let out = vgsel(&["check", "--model", m, "--sequence"]);
     assert_eq!(out.status.code(), Some(2), "{out:?}");
     let missing = dir.path().join("nothing");
     let out = vgsel(&["check", "--model", missing.to_str().unwrap()]);

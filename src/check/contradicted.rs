@@ -8,8 +8,10 @@
 //! look-alike's own false pairs to its neighbours free, and the next run put the look-alike
 //! there (street seed 72).
 
+use super::resection::AGREE_PX;
 use super::splits::Sets;
 use super::views::Views;
+use std::collections::HashMap;
 
 /// A pair is judged with at least this many of its matches on points in both images...
 pub const MIN_HELD: usize = 20;
@@ -31,20 +33,76 @@ pub fn refused_pairs(views: &Views, group: &[Option<bool>]) -> Vec<[String; 2]> 
         if group[a].is_none() || group[a] != group[b] {
             continue;
         }
-        let (joined, apart) = views.matches_held(a, b);
-        if joined + apart < MIN_HELD {
-            continue;
-        }
-        if apart as f64 > APART_RATIO * joined as f64 {
-            judged.push((a, b));
-        } else if joined >= apart {
-            tied.union(a, b);
+        match held(views, a, b) {
+            Some(Held::Apart) => judged.push((a, b)),
+            Some(Held::Joined) => {
+                tied.union(a, b);
+            }
+            None => {}
         }
     }
     let mut out: Vec<[String; 2]> = judged
         .into_iter()
         .filter(|&(a, b)| tied.find(a) == tied.find(b))
         .map(|(a, b)| {
+            let (x, y) = (&views.views[a].name, &views.views[b].name);
+            [x.min(y).clone(), x.max(y).clone()]
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// What a model says of one pair's matches, where it says enough ([`MIN_HELD`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Held {
+    /// More than [`APART_RATIO`] times as many apart as as one point: refused.
+    Apart,
+    /// At least as many as one point as apart: confirmed.
+    Joined,
+}
+
+/// How the model holds the matches of views `a` and `b`: refused, confirmed, or neither.
+fn held(views: &Views, a: usize, b: usize) -> Option<Held> {
+    let (joined, apart) = views.matches_held(a, b);
+    verdict(joined, apart)
+}
+
+/// A pair's verdict from its matches held as one point (`joined`) and as two (`apart`).
+fn verdict(joined: usize, apart: usize) -> Option<Held> {
+    if joined + apart < MIN_HELD {
+        None
+    } else if apart as f64 > APART_RATIO * joined as f64 {
+        Some(Held::Apart)
+    } else {
+        (joined >= apart).then_some(Held::Joined)
+    }
+}
+
+/// The pairs of views next to each other in `order` (every image's name, in capture order)
+/// whose matches the model holds apart ([`MIN_HELD`], [`APART_RATIO`]; two points that each
+/// project within [`AGREE_PX`] of the other's keypoint count as one), as name pairs in name
+/// order, sorted. Where the capture is one sequence, an image and the next saw the same scene,
+/// so their matches are true: a model that holds them as two surfaces put one of the two on
+/// another copy. On the lab photographs' folds the pairs across the fold are held apart
+/// (Books' frames 13 and 14: none of their matches as one point, 110 as two), in their correct
+/// models as one. Only the next image: two or three frames apart, a street's false pairs
+/// already occur (docs/check.md, "The capture order").
+pub fn neighbours_apart(views: &Views, order: &[String]) -> Vec<[String; 2]> {
+    let rank: HashMap<&str, usize> = (order.iter().enumerate())
+        .map(|(k, name)| (name.as_str(), k))
+        .collect();
+    let position = |v: usize| rank.get(views.views[v].name.as_str()).copied();
+    let mut out: Vec<[String; 2]> = (views.matches.keys())
+        .filter(|&&(a, b)| match (position(a), position(b)) {
+            (Some(x), Some(y)) => x.abs_diff(y) == 1,
+            _ => false,
+        })
+        .filter(|&&(a, b)| {
+            let (joined, apart) = views.matches_placed(a, b, AGREE_PX);
+            verdict(joined, apart) == Some(Held::Apart)
+        })
+        .map(|&(a, b)| {
             let (x, y) = (&views.views[a].name, &views.views[b].name);
             [x.min(y).clone(), x.max(y).clone()]
         })

@@ -24,6 +24,8 @@ pub struct Evidence {
     /// name pair, keypoint in the second), pruned or not: a prune does not change what the
     /// images saw.
     pub matches: BTreeMap<NamePair, Vec<[u32; 2]>>,
+    /// Every image's name, sorted: the capture order where the names sort in it.
+    pub images: Vec<String>,
 }
 
 impl Evidence {
@@ -60,7 +62,16 @@ impl Evidence {
             };
             matches.insert(key, inliers);
         }
-        Ok(Evidence { pairs, matches })
+        let images = names
+            .into_values()
+            .collect::<BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        Ok(Evidence {
+            pairs,
+            matches,
+            images,
+        })
     }
 
     /// The images that a pair a mapper would use (at least `min_num_matches` inliers) links and

@@ -110,6 +110,10 @@ pub struct ModelCheck<'e> {
     /// points for under [`ANCHORED_FRACTION`] of their matched keypoints; in a model without
     /// any point, those the database matched to each other. Sorted.
     pub unanchored: Vec<String>,
+    /// With the database and [`CheckSettings::sequence`]: the pairs of images next to each
+    /// other in the capture order whose matches the model holds apart
+    /// ([`contradicted::neighbours_apart`]). The model is wrong. Sorted.
+    pub neighbours_apart: Vec<[String; 2]>,
     /// For a wrong model (ghosted, or placing a group or images elsewhere), the pairs inside
     /// the groups it placed consistently whose matches it holds apart
     /// ([`contradicted::refused_pairs`]): the repair blames them too. Sorted.
@@ -129,10 +133,13 @@ pub struct ModelCheck<'e> {
 }
 
 impl ModelCheck<'_> {
-    /// Ghosted, a group of it misplaced, or images in it unanchored: the model is wrong where
-    /// the check can tell.
+    /// Ghosted, a group of it misplaced, images in it unanchored, or neighbours in the capture
+    /// order held apart: the model is wrong where the check can tell.
     pub fn wrong(&self) -> bool {
-        self.ghosted || self.places_elsewhere() || !self.unanchored.is_empty()
+        self.ghosted
+            || self.places_elsewhere()
+            || !self.unanchored.is_empty()
+            || !self.neighbours_apart.is_empty()
     }
 
     /// The database's matches place a group or an image of it elsewhere than the model does.
@@ -209,6 +216,10 @@ pub fn check_model<'e>(
         .then(|| weakest_link(&views, &covisibility, &reach, &side, pairs, settings))
         .flatten();
     let score = split.as_ref().map_or(0.0, |s| s.score);
+    let neighbours_apart = match evidence {
+        Some(e) if settings.sequence => contradicted::neighbours_apart(&views, &e.images),
+        _ => Vec::new(),
+    };
     Ok(ModelCheck {
         images: n,
         points: views.points.len(),
@@ -221,6 +232,7 @@ pub fn check_model<'e>(
         misplaced_images: Vec::new(),
         ghost_of_images: false,
         unanchored: unanchored(&views),
+        neighbours_apart,
         refused: Vec::new(),
         side,
         weakest_link,

@@ -18,6 +18,9 @@ pub struct CheckSettings {
     /// Agreeing samples every split is credited with before counting: the score is
     /// conflicting / (judged + prior), so a ratio over few samples counts for less.
     pub prior: usize,
+    /// With the database: the images' names sort in capture order, one sequence, each image
+    /// overlapping the next (`--sequence`; [`super::contradicted::neighbours_apart`]).
+    pub sequence: bool,
 }
 
 /// The defaults, the one setting of docs/check.md's measurements.
@@ -32,6 +35,7 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     threshold: 0.48,
     min_conflicts: 30,
     prior: 500,
+    sequence: false,
 };
 
 /// A split's score: conflicting over judged samples plus the prior.

@@ -468,6 +468,41 @@ fn a_model_without_points_is_unanchored_where_the_database_matched_its_images() 
     assert!(check.wrong());
 }
 
+/// With the capture order (`sequence`), an image and the next whose matches the model holds as
+/// two surfaces make a clean model wrong; two images apart, or without the order, the same
+/// matches say nothing.
+#[test]
+fn neighbours_in_the_capture_order_held_apart_make_the_model_wrong() {
+    let model = one_image_model(false);
+    let mut names: Vec<String> = (model.images.iter())
+        .map(|i| i.image.name.clone())
+        .collect();
+    names.sort();
+    // Each keypoint of one image matched to the next point's keypoint in the other.
+    let evidence_with = |other: usize| {
+        let (a, b) = (&model.images[other], &model.images[12]);
+        let mut evidence = Evidence {
+            images: names.clone(),
+            ..Evidence::default()
+        };
+        let key = (a.image.name.clone(), b.image.name.clone());
+        evidence.matches.insert(key, matches_of(a, b, |id| id + 1));
+        evidence
+    };
+    let ordered = CheckSettings {
+        sequence: true,
+        ..DEFAULT_SETTINGS
+    };
+    let (next, second_next) = (evidence_with(11), evidence_with(10));
+    let near = check_model(&model, Some(&next), &ordered).unwrap();
+    assert_eq!(near.neighbours_apart, [["0012.png", "0013.png"]]);
+    assert!(near.wrong() && !near.ghosted);
+    let far = check_model(&model, Some(&second_next), &ordered).unwrap();
+    assert!(far.neighbours_apart.is_empty() && !far.wrong());
+    let unordered = check_model(&model, Some(&next), &DEFAULT_SETTINGS).unwrap();
+    assert!(unordered.neighbours_apart.is_empty() && !unordered.wrong());
+}
+
 #[test]
 fn the_check_is_deterministic() {
     let a = check_model(&ghosted_model(), None, &DEFAULT_SETTINGS).unwrap();
@@ -1244,7 +1279,7 @@ fn images_a_usable_pair_links_and_no_model_registered_are_unregistered() {
         ]
         .into_iter()
         .collect(),
-        matches: BTreeMap::new(),
+        ..Evidence::default()
     };
     // 0014 and 0015 share fewer inliers than the mapper uses: nothing links them.
     assert_eq!(evidence.unregistered(&models, 15), ["0013.png"]);

@@ -13,8 +13,9 @@ use vgsel_colmap::colmap::sparse::{read_sparse_model, SparseModel};
 use vgsel_colmap::geometry::similarity::Similarity;
 use vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 
-/// Exit status of a check that found a model wrong: ghosted, with a misplaced group, or with
-/// images registered on (next to) no 3D point.
+/// Exit status of a check that found a model wrong: ghosted, with a misplaced group or image,
+/// folded against the capture order (`--sequence`), or with images registered on (next to) no
+/// 3D point.
 pub const EXIT_GHOSTED: u8 = 3;
 
 #[derive(Args)]
@@ -45,6 +46,11 @@ pub struct CheckArgs {
     /// their strongest placement without conflict joins them.
     #[arg(long, value_name = "DIR", requires = "database_path")]
     earlier_model: Vec<PathBuf>,
+    /// The images' names sort in capture order, one sequence (a walk, an orbit, a video), each
+    /// image overlapping the next: a model that holds the matches of an image and the next as
+    /// two surfaces is folded.
+    #[arg(long, requires = "database_path")]
+    sequence: bool,
     /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = super::args::fraction)]
     threshold: f64,
@@ -80,17 +86,20 @@ impl CheckArgs {
         s.min_group = self.min_group.max(1);
         s.min_conflicts = self.min_conflicts;
         s.prior = self.prior;
+        s.sequence = self.sequence;
         s
     }
 }
 
 /// A model's verdict in a word: what is wrong with it first (ghosted, then misplaced, then
-/// unanchored), or clean.
+/// folded onto itself against the capture order, then unanchored), or clean.
 fn verdict(c: &ModelCheck) -> &'static str {
     if c.ghosted {
         "ghosted"
     } else if c.places_elsewhere() {
         "misplaced"
+    } else if !c.neighbours_apart.is_empty() {
+        "folded"
     } else if !c.unanchored.is_empty() {
         "unanchored"
     } else {
@@ -172,6 +181,14 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
             m.links.len(),
             m.against.len(),
             m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
+        );
+    }
+    if !c.neighbours_apart.is_empty() {
+        let n = c.neighbours_apart.len();
+        line += &format!(
+            "; {n} pair{} of images next in the capture order held as two surfaces, e.g. {}",
+            if n == 1 { "" } else { "s" },
+            examples(c.neighbours_apart.iter().map(|[a, b]| (a, b)))
         );
     }
     if !c.unanchored.is_empty() {
@@ -330,6 +347,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
     let ghosted = run.models.iter().any(|c| c.ghosted);
     let misplaced = run.models.iter().any(ModelCheck::places_elsewhere);
     let unanchored = run.models.iter().any(|c| !c.unanchored.is_empty());
+    let folded = run.models.iter().any(|c| !c.neighbours_apart.is_empty());
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
     let mut joined = Vec::new();
@@ -350,6 +368,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             "ghosted": ghosted,
             "misplaced": misplaced,
             "unanchored": unanchored,
+            "folded": folded,
             "settings": settings,
             "models": reports,
             "joins": joined,
