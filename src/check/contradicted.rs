@@ -64,7 +64,7 @@ enum Held {
 
 /// How the model holds the matches of views `a` and `b`: refused, confirmed, or neither.
 fn held(views: &Views, a: usize, b: usize) -> Option<Held> {
-    let (joined, apart) = views.matches_held(a, b);
+    let (joined, apart) = views.matches_held(a, b, None);
     verdict(joined, apart)
 }
 
@@ -99,7 +99,7 @@ pub fn neighbours_apart(views: &Views, order: &[String]) -> Vec<[String; 2]> {
             _ => false,
         })
         .filter(|&&(a, b)| {
-            let (joined, apart) = views.matches_placed(a, b, AGREE_PX);
+            let (joined, apart) = views.matches_held(a, b, Some(AGREE_PX));
             verdict(joined, apart) == Some(Held::Apart)
         })
         .map(|&(a, b)| {

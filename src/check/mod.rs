@@ -399,7 +399,7 @@ fn describe(
             // Pairs that share points joined the groups in this model, even if the database
             // invalidated them since (a second `prune --model` must blame them again).
             if inliers > 0 || shared > 0 {
-                let (matches_joined, matches_apart) = views.matches_held(a, b);
+                let (matches_joined, matches_apart) = views.matches_held(a, b, None);
                 joining.push(JoiningPair {
                     image1: na.clone(),
                     image2: nb.clone(),

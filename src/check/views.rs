@@ -250,31 +250,15 @@ impl<'e> Views<'e> {
 
     /// The verified matches of views `a` and `b` whose keypoints both observe points: how many
     /// observe the same point, and how many two different ones (the model holds them apart).
-    pub fn matches_held(&self, a: usize, b: usize) -> (usize, usize) {
-        let (pa, pb) = (&self.views[a].point_of, &self.views[b].point_of);
-        let (mut joined, mut apart) = (0, 0);
-        for [x, y] in self.pair_matches(a, b) {
-            let at = |p: &[Option<usize>], k: u32| p.get(k as usize).copied().flatten();
-            if let (Some(p), Some(q)) = (at(pa, x), at(pb, y)) {
-                if p == q {
-                    joined += 1;
-                } else {
-                    apart += 1;
-                }
-            }
-        }
-        (joined, apart)
-    }
-
-    /// [`Self::matches_held`], but two different points that each project within `px` of the
-    /// other view's keypoint hold the match too: a selection that dropped the pair made the
-    /// same surface twice at the same place, which is no contradiction.
-    pub fn matches_placed(&self, a: usize, b: usize, px: f64) -> (usize, usize) {
+    /// With `within` pixels, two different points that each project that close to the other
+    /// view's keypoint count as one: a selection that dropped the pair made the same surface
+    /// twice at the same place, which contradicts nothing.
+    pub fn matches_held(&self, a: usize, b: usize, within: Option<f64>) -> (usize, usize) {
         let (pa, pb) = (&self.views[a].point_of, &self.views[b].point_of);
         let near = |v: usize, point: usize, k: u32| {
             let at = self.views[v].keypoints[k as usize];
-            self.project(v, point)
-                .is_some_and(|xy| (xy[0] - at[0]).hypot(xy[1] - at[1]) <= px)
+            (within.zip(self.project(v, point)))
+                .is_some_and(|(px, xy)| (xy[0] - at[0]).hypot(xy[1] - at[1]) <= px)
         };
         let (mut joined, mut apart) = (0, 0);
         for [x, y] in self.pair_matches(a, b) {
