@@ -6,7 +6,9 @@
 //! model refused"). `prune --model` blames them with the glue, so the next selection cannot
 //! take them instead: without this, a camera placed back from its look-alike's spot left the
 //! look-alike's own false pairs to its neighbours free, and the next run put the look-alike
-//! there (street seed 72).
+//! there (street seed 72). Where the capture is one sequence (`--sequence`), an image and the
+//! next belong together whatever the model says: a model that holds their matches apart is
+//! folded ([`neighbours_apart`]).
 
 use super::resection::AGREE_PX;
 use super::splits::Sets;
@@ -56,9 +58,10 @@ pub fn refused_pairs(views: &Views, group: &[Option<bool>]) -> Vec<[String; 2]> 
 /// What a model says of one pair's matches, where it says enough ([`MIN_HELD`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Held {
-    /// More than [`APART_RATIO`] times as many apart as as one point: refused.
+    /// More than [`APART_RATIO`] times as many matches held apart as held as one point:
+    /// refused.
     Apart,
-    /// At least as many as one point as apart: confirmed.
+    /// At least as many held as one point as held apart: confirmed.
     Joined,
 }
 
@@ -86,8 +89,8 @@ fn verdict(joined: usize, apart: usize) -> Option<Held> {
 /// so their matches are true: a model that holds them as two surfaces put one of the two on
 /// another copy. On the lab photographs' folds the pairs across the fold are held apart
 /// (Books' frames 13 and 14: none of their matches as one point, 110 as two), in their correct
-/// models as one. Only the next image: two or three frames apart, a street's false pairs
-/// already occur (docs/check.md, "The capture order").
+/// models as one. Only the next image: two frames apart, a correct model of the lab Street
+/// already holds a pair's matches apart (docs/check.md, "The capture order").
 pub fn neighbours_apart(views: &Views, order: &[String]) -> Vec<[String; 2]> {
     let rank: HashMap<&str, usize> = (order.iter().enumerate())
         .map(|(k, name)| (name.as_str(), k))
