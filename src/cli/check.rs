@@ -164,24 +164,7 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         }
     }
     for m in &c.misplaced_images {
-        // A pose far outside the model (RANSAC on few distant points) is no distance worth
-        // printing.
-        let distance = match m.moved {
-            d if d > 10.0 => "over 10 times the model's spread".to_string(),
-            d => format!("{:.0}% of the model's spread", 100.0 * d),
-        };
-        line += &format!(
-            "; the database's matches place {} {distance} away ({} of {} correspondences \
-             agree, {} with the model's pose); {} pairs place it back, {} against it, {} \
-             matches hold it there",
-            m.image,
-            m.support,
-            m.correspondences,
-            m.model_support,
-            m.links.len(),
-            m.against.len(),
-            m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
-        );
+        line += &misplaced_image_text(m);
     }
     if !c.neighbours_apart.is_empty() {
         let n = c.neighbours_apart.len();
@@ -205,6 +188,28 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         );
     }
     line + ")"
+}
+
+/// Where the database's matches place one image, and the pairs for and against it.
+fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
+    // A pose far outside the model (RANSAC on few distant points) is no distance worth
+    // printing.
+    let distance = match m.moved {
+        d if d > 10.0 => "over 10 times the model's spread".to_string(),
+        d => format!("{:.0}% of the model's spread", 100.0 * d),
+    };
+    format!(
+        "; the database's matches place {} {distance} away ({} of {} correspondences agree, \
+         {} with the model's pose); {} pairs place it back, {} against it, {} matches hold it \
+         there",
+        m.image,
+        m.support,
+        m.correspondences,
+        m.model_support,
+        m.links.len(),
+        m.against.len(),
+        m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
+    )
 }
 
 /// Where the database's matches place a model's second group, and the pairs that link it.
