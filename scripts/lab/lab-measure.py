@@ -317,6 +317,10 @@ def scored_run(images, work, dbs, spec):
     if preset == "repair":
         result, models = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}"), []
         for turn in range(1, REPAIR_TURNS + 1):
+            # A turn whose mapper made no model (COLMAP 3.8 found no initial pair) ends the
+            # loop, recorded as it is (pipeline.sh keeps the model before it).
+            if not os.listdir(result["sparse"]):
+                break
             report = result["sparse"] + ".check.json"
             earlier = ["--earlier_model" if a == "--model" else a for a in models]
             checked = subprocess.run([VGSEL, "check", "--model", result["sparse"],

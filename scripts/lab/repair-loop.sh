@@ -34,8 +34,9 @@ map_with() { # MAPPER DB OUT STEP: COLMAP 3.8's mapper (colmap3.8) or pycolmap's
     init=(--Mapper.init_min_tri_angle "$REPAIR_INIT_ANGLE")
   if [ "$1" = colmap3.8 ]; then
     mkdir -p "$3"
+    # A repair turn's selection can leave COLMAP 3.8 no initial pair: that turn makes no model.
     nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3" \
-      "${init[@]}" >"$3.log" 2>&1
+      "${init[@]}" >"$3.log" 2>&1 || grep -q "failed to create sparse model" "$3.log"
     echo '{}' >"$3.json"
     if [ -n "$repair" ] && [ "${LEFT_OUT:-1}" = 1 ]; then
       VGSEL=$bin nice scripts/map-left-out.sh "$2" "$images" "$3" "${init[@]}" >/dev/null
@@ -67,6 +68,11 @@ for run in $(seq 1 "$runs"); do
         model=$dir/${mapper}_$step
         map_with "$mapper" "$db" "$model" "$step"
         score "$model" "$db" >"$model.eval.json"
+        if [ -z "$(ls -A "$model")" ]; then
+          # The turn made no model: the loop stops there, recorded as such.
+          echo '{"no_model": true, "repair": {}}' >"$model.check.json"
+          break
+        fi
         status=0
         # The earlier turns' models (the list `prune --model` gets) as --earlier_model.
         "$bin" check --model "$model" --database_path "$db" "${models[@]/#--model/--earlier_model}" \
@@ -86,7 +92,8 @@ python3 - "$work" "$runs" "$mappers" "$num_images" <<'PY'
 import json, os, sys
 work, runs, mappers, n = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
 rows = []
-verdict = lambda c: next((k for k in ("ghosted", "misplaced", "unanchored") if c.get(k)), "clean")
+verdict = lambda c: next((k.replace("_", " ") for k in ("no_model", "ghosted", "misplaced", "unanchored")
+                          if c.get(k)), "clean")
 print(f"{'run':>3} {'matching':<12} {'mapper':<10} {'first: correct':>14} {'check':>10} "
       f"{'turns':>5} {'after the loop: correct':>23} {'models':>6} {'check':>10}")
 for run in range(1, runs + 1):
@@ -97,10 +104,11 @@ for run in range(1, runs + 1):
             while os.path.exists(f"{base}_{len(steps) + 1}.eval.json"):
                 e = json.load(open(f"{base}_{len(steps) + 1}.eval.json"))
                 c = json.load(open(f"{base}_{len(steps) + 1}.check.json"))
-                steps.append(dict(correct=e["correct"], registered=e["registered"],
-                                  models=e["models"], ghosted=c["ghosted"],
+                steps.append(dict(correct=e.get("correct", 0), registered=e["registered"],
+                                  models=e["models"], ghosted=c.get("ghosted", False),
                                   misplaced=c.get("misplaced", False),
-                                  unanchored=c.get("unanchored", False)))
+                                  unanchored=c.get("unanchored", False),
+                                  no_model=c.get("no_model", False)))
             if not steps:
                 continue
             rows.append(dict(run=run, matching=matcher, mapper=mapper, steps=steps))
