@@ -106,6 +106,32 @@ fn truth_ghosted(eval: &Value) -> bool {
     wrong >= 2 && wrong * 5 >= registered
 }
 
+/// The pipeline's `variant` (full, pruned) in `work`: its eval, model folder and database.
+fn variant_run(work: &Path, variant: &str) -> (Value, PathBuf, PathBuf) {
+    let eval = std::fs::read_to_string(work.join(format!("eval_{variant}.json"))).unwrap();
+    (
+        serde_json::from_str(&eval).unwrap(),
+        work.join(format!("sparse_{variant}")),
+        work.join(format!("{variant}.db")),
+    )
+}
+
+/// `check` of `model` with its database `db`, `more` options, and the images no model
+/// registered written to `left`.
+fn check_with(model: &Path, db: &Path, more: &[&str], left: &Path) -> Output {
+    let mut args = vec![
+        "check",
+        "--model",
+        model.to_str().unwrap(),
+        "--database_path",
+        db.to_str().unwrap(),
+        "--unregistered",
+        left.to_str().unwrap(),
+    ];
+    args.extend_from_slice(more);
+    vgsel(&args)
+}
+
 /// The rendered scene `kind` (`num_images`, seed 1) in a temporary folder, run through
 /// `scripts/pipeline.sh` with `--preset disambiguation` and `REPAIR=repair` turns of the loop
 /// (1024 SIFT features, the renderer's intrinsics): the folder and the pipeline's work folder.
@@ -139,25 +165,10 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
     let (dir, work) = pipeline(SceneKind::Duplicate, 20, 0);
     let mut verdicts = Vec::new();
     for variant in ["full", "pruned"] {
-        let eval: Value = serde_json::from_str(
-            &std::fs::read_to_string(work.join(format!("eval_{variant}.json"))).unwrap(),
-        )
-        .unwrap();
-        let model = work.join(format!("sparse_{variant}"));
-        let db = work.join(format!("{variant}.db"));
+        let (eval, model, db) = variant_run(&work, variant);
         let report = work.join(format!("check_{variant}.json"));
         let left = work.join(format!("left_{variant}.txt"));
-        let out = vgsel(&[
-            "check",
-            "--model",
-            model.to_str().unwrap(),
-            "--database_path",
-            db.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-            "--unregistered",
-            left.to_str().unwrap(),
-        ]);
+        let out = check_with(&model, &db, &["--report", report.to_str().unwrap()], &left);
         // The list a second mapper run would read: images no model registered, none when
         // all 20 are (as COLMAP 3.8 registers them here).
         let listed = std::fs::read_to_string(&left).unwrap();
@@ -184,6 +195,42 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
     eprintln!("exit statuses full, pruned: {verdicts:?}");
     repair_from_the_full_model(&work, &dir.path().join("images"), &dir.path().join("gt"));
     left_out_images_are_mapped_on_their_own(&work, &dir.path().join("images"));
+}
+
+/// The symmetric orbit (24 images, one sequence in name order), full and pruned, COLMAP 3.8:
+/// its fold conflicts with nothing, so the check alone calls it clean; with `--sequence` the
+/// verdict is the ground truth's, and a folded model names the neighbours it held apart.
+#[test]
+fn the_capture_order_tells_the_symmetric_orbit_folded() {
+    let (_dir, work) = pipeline(SceneKind::Symmetric, 24, 0);
+    for variant in ["full", "pruned"] {
+        let (eval, model, db) = variant_run(&work, variant);
+        let report = work.join(format!("sequence_{variant}.json"));
+        let left = work.join(format!("sequence_left_{variant}.txt"));
+        let out = check_with(
+            &model,
+            &db,
+            &["--sequence", "--report", report.to_str().unwrap()],
+            &left,
+        );
+        let line = String::from_utf8_lossy(&out.stdout).to_string();
+        eprintln!("{variant}: {} correct; {line}", eval["correct"]);
+        let value: Value =
+            serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        assert_eq!(out.status.code() == Some(3), truth_ghosted(&eval), "{line}");
+        assert_eq!(
+            value["folded"].as_bool().unwrap(),
+            truth_ghosted(&eval),
+            "{line}"
+        );
+        if truth_ghosted(&eval) {
+            assert!(line.contains("FOLDED"), "{line}");
+            assert!(!value["models"][0]["neighbours_apart"]
+                .as_array()
+                .unwrap()
+                .is_empty());
+        }
+    }
 }
 
 /// COLMAP 3.8's mapper on `db` into `out` (created), on the images `list` names or on all.
