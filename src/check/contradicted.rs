@@ -35,7 +35,7 @@ pub fn refused_pairs(views: &Views, group: &[Option<bool>]) -> Vec<[String; 2]> 
         if group[a].is_none() || group[a] != group[b] {
             continue;
         }
-        match held(views, a, b) {
+        match held(views, a, b, None) {
             Some(Held::Apart) => judged.push((a, b)),
             Some(Held::Joined) => {
                 tied.union(a, b);
@@ -65,14 +65,10 @@ enum Held {
     Joined,
 }
 
-/// How the model holds the matches of views `a` and `b`: refused, confirmed, or neither.
-fn held(views: &Views, a: usize, b: usize) -> Option<Held> {
-    let (joined, apart) = views.matches_held(a, b, None);
-    verdict(joined, apart)
-}
-
-/// A pair's verdict from its matches held as one point (`joined`) and as two (`apart`).
-fn verdict(joined: usize, apart: usize) -> Option<Held> {
+/// How the model holds the matches of views `a` and `b` ([`Views::matches_held`], `within`
+/// its pixels): refused, confirmed, or neither.
+fn held(views: &Views, a: usize, b: usize, within: Option<f64>) -> Option<Held> {
+    let (joined, apart) = views.matches_held(a, b, within);
     if joined + apart < MIN_HELD {
         None
     } else if apart as f64 > APART_RATIO * joined as f64 {
@@ -101,10 +97,7 @@ pub fn neighbours_apart(views: &Views, order: &[String]) -> Vec<[String; 2]> {
             (Some(x), Some(y)) => x.abs_diff(y) == 1,
             _ => false,
         })
-        .filter(|&&(a, b)| {
-            let (joined, apart) = views.matches_held(a, b, Some(AGREE_PX));
-            verdict(joined, apart) == Some(Held::Apart)
-        })
+        .filter(|&&(a, b)| held(views, a, b, Some(AGREE_PX)) == Some(Held::Apart))
         .map(|&(a, b)| {
             let (x, y) = (&views.views[a].name, &views.views[b].name);
             [x.min(y).clone(), x.max(y).clone()]

@@ -62,11 +62,8 @@ impl Evidence {
             };
             matches.insert(key, inliers);
         }
-        let images = names
-            .into_values()
-            .collect::<BTreeSet<_>>()
-            .into_iter()
-            .collect();
+        let mut images: Vec<String> = names.into_values().collect();
+        images.sort();
         Ok(Evidence {
             pairs,
             matches,
