@@ -38,14 +38,13 @@ bin=${VGSEL:-$here/target/release/vgsel-colmap}
 log() { echo "pipeline: $*" >&2; }
 
 # Seconds taken by a command, its output going to a log file; fails with the log's tail, unless
-# the log says $tolerated (an outcome, not a failure).
-tolerated=
+# the log says $tolerated (an outcome, not a failure; set for one call: `tolerated=... timed`).
 timed() {
   local logfile=$1
   shift
   local start
   start=$(date +%s.%N)
-  if ! nice "$@" >"$logfile" 2>&1 && ! { [ -n "$tolerated" ] && grep -q "$tolerated" "$logfile"; }; then
+  if ! nice "$@" >"$logfile" 2>&1 && ! { [ -n "${tolerated:-}" ] && grep -q "$tolerated" "$logfile"; }; then
     tail -n 20 "$logfile" >&2
     echo "pipeline: failed: $* (log: $logfile)" >&2
     exit 1
@@ -97,10 +96,11 @@ map_and_eval() {
     mkdir -p "$sparse"
     log "mapper on the $variant database"
     # A repair turn's selection can leave COLMAP 3.8 no initial pair: that turn makes no model.
-    [[ $variant == repaired* ]] && tolerated="failed to create sparse model"
-    timed "$work/mapper_$variant.log" colmap mapper --database_path "$work/$variant.db" \
-      --image_path "$images" --output_path "$sparse" --Mapper.extract_colors 0 >"$sparse.seconds"
-    tolerated=
+    local outcome=
+    [[ $variant == repaired* ]] && outcome="failed to create sparse model"
+    tolerated=$outcome timed "$work/mapper_$variant.log" colmap mapper \
+      --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse" \
+      --Mapper.extract_colors 0 >"$sparse.seconds"
     [[ $variant == repaired* ]] && map_left_out "$variant"
   fi
   eval_args=(--model "$sparse" --database_path "$work/$variant.db")
