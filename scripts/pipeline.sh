@@ -18,8 +18,9 @@
 #   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
 #   REPAIR          N > 0: the repair loop (docs/check.md), at most N turns: `vgsel-colmap
 #                   check` on the last model, and where its report's `repair` is not empty
-#                   (a ghost's pairs to blame, or pairs that place a misplaced group or join
-#                   clean models), `prune --model` with every model so far and one more mapper run,
+#                   (a ghost's pairs to blame, or pairs that place a misplaced group, join
+#                   clean models or place an image no model registered), `prune --model` with
+#                   every model so far and one more mapper run,
 #                   a row `repairedK` per turn [0]; in a repair turn, the images the database
 #                   links and the mapper left out (a piece the blame cut off: COLMAP 3.8 starts
 #                   no second model from narrow pairs) are mapped on their own into
@@ -115,7 +116,7 @@ last=pruned models=() earlier=()
 # Every model is checked, the last turn's too, after the models before it (a clean model's
 # pieces an earlier ghost had put onto each other join); a turn runs where the check gives
 # `prune --model` something to act on (its report's `repair`: pairs a ghost blames, pairs that
-# place a misplaced group or join clean models).
+# place a misplaced group, join clean models or place an image no model registered).
 for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   [ "${REPAIR:-0}" -gt 0 ] || break
   status=0
@@ -128,7 +129,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   [ "$turn" -le "$REPAIR" ] || break
   models+=(--model "$work/sparse_$last")
   earlier+=(--earlier_model "$work/sparse_$last")
-  log "the $last model is ghosted, misplaced or in pieces: prune --model (turn $turn), mapper again"
+  log "the $last model is ghosted, misplaced, in pieces or lost images: prune --model (turn $turn), mapper again"
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
     --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args

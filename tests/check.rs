@@ -64,10 +64,11 @@ fn check_exit_statuses_report_and_plots() {
     assert_eq!(value["models"][0]["ghost_placement"], Value::Null);
     assert_eq!(
         value["repair"],
-        serde_json::json!({ "blamed": [], "dropped": [], "links": [] })
+        serde_json::json!({ "blamed": [], "dropped": [], "links": [], "rejoin": [] })
     );
     assert_eq!(value["models"][0]["images"], 2);
     assert_eq!(value["unregistered"], serde_json::json!([]));
+    assert_eq!(value["rejoined"], serde_json::json!([]));
     assert!(plots.join("top_view_0.svg").is_file());
     // The images left out are the database's to tell.
     let left = dir.path().join("left.txt");
@@ -195,6 +196,8 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
     eprintln!("exit statuses full, pruned: {verdicts:?}");
     repair_from_the_full_model(&work, &dir.path().join("images"), &dir.path().join("gt"));
     left_out_images_are_mapped_on_their_own(&work, &dir.path().join("images"));
+    let (images, gt) = (dir.path().join("images"), dir.path().join("gt"));
+    a_lost_image_is_placed_and_kept_by_the_next_prune(&work, &images, &gt);
 }
 
 /// The symmetric orbit (24 images, one sequence in name order), full and pruned, COLMAP 3.8:
@@ -306,6 +309,85 @@ fn left_out_images_are_mapped_on_their_own(work: &Path, images: &Path) {
             assert!(again.lines().count() < listed.len(), "{again}");
         }
     }
+}
+
+/// An image a prune left out (`--forbid_images`), so no model registered it: where the model
+/// is clean, `check` places it by its matches and names the pairs that place it, which this
+/// database does not offer; `prune --model` on the full database keeps exactly those, and the
+/// next mapper run registers the image.
+fn a_lost_image_is_placed_and_kept_by_the_next_prune(work: &Path, images: &Path, gt: &Path) {
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let first = std::fs::read_dir(images)
+        .unwrap()
+        .map(|e| e.unwrap().file_name());
+    let first = first.min().unwrap().to_string_lossy().into_owned();
+    let forbid = work.join("forbid_first.txt");
+    std::fs::write(&forbid, format!("{first}\n")).unwrap();
+    let (full, lost, model) = (
+        work.join("full.db"),
+        work.join("lost.db"),
+        work.join("sparse_lost"),
+    );
+    let prune = |out: &Path, more: &[&str]| {
+        let args = ["prune", "-q", "--preset", "disambiguation", "--overwrite"];
+        let io = ["--database_path", &s(&full), "--output", &s(out)];
+        let out = vgsel(&[&args[..], &io[..], more].concat());
+        assert!(out.status.success(), "{out:?}");
+    };
+    prune(&lost, &["--forbid_images", &s(&forbid)]);
+    let mapper = colmap_mapper(&lost, images, &model, None);
+    assert!(mapper.status.success(), "{mapper:?}");
+    let report = work.join("check_lost.json");
+    let out = check_with(
+        &model,
+        &lost,
+        &["--report", &s(&report)],
+        &work.join("lost.txt"),
+    );
+    let value: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let line = String::from_utf8_lossy(&out.stdout).to_string();
+    eprintln!("{first} left out: {line}");
+    // Its pairs are all invalidated: it is no image the database's pairs link.
+    assert!(
+        !value["unregistered"].to_string().contains(&first),
+        "{value}"
+    );
+    let rejoin = value["repair"]["rejoin"].as_array().unwrap().clone();
+    if out.status.code() != Some(0) {
+        // A wrong model is no frame to place it in.
+        assert!(rejoin.is_empty(), "{line}");
+        return;
+    }
+    assert_eq!(value["rejoined"][0]["image"], first.as_str(), "{value}");
+    assert!(!rejoin.is_empty(), "{line}");
+    assert!(
+        rejoin.iter().all(|p| p.to_string().contains(&first)),
+        "{rejoin:?}"
+    );
+    assert!(line.contains("placed by their matches"), "{line}");
+    let again = work.join("rejoined.db");
+    let prune_report = work.join("prune_rejoined.json");
+    prune(
+        &again,
+        &["--model", &s(&model), "--report", &s(&prune_report)],
+    );
+    let prune_report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&prune_report).unwrap()).unwrap();
+    // The pairs that are view-graph edges (15 inliers) among them, none blamed.
+    let kept = prune_report["overrides"]["model_rejoins"]
+        .as_array()
+        .unwrap();
+    assert!(
+        !kept.is_empty() && kept.iter().all(|p| rejoin.contains(p)),
+        "{kept:?}"
+    );
+    let model = work.join("sparse_rejoined");
+    let mapper = colmap_mapper(&again, images, &model, None);
+    assert!(mapper.status.success(), "{mapper:?}");
+    let eval = vgsel(&["eval", "--model", &s(&model), "--ground_truth", &s(gt)]);
+    let eval: Value = serde_json::from_slice(&eval.stdout).unwrap();
+    let names = eval["images"].as_array().unwrap().iter();
+    assert!(names.clone().any(|i| i["name"] == first.as_str()), "{eval}");
 }
 
 /// `eval --placements` places every registered image (each has far more than 30

@@ -23,7 +23,9 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             verified pairs FILE lists, one `NAME1 NAME2` a line, e.g. another method's
             selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; `repair`:
             the repair loop after the `disambiguation` run of the same variant, order and mapper:
-            `check` its model, and where it is ghosted `prune --model` with every model so far
+            `check` its model, and where its report's `repair` is not empty (a ghost, a
+            misplaced group or image, pieces to join, lost images to place) `prune --model`
+            with every model so far
             and map once more, at most REPAIR_TURNS times, else that run stands; with COLMAP
             3.8 each turn also maps the images it left out, scripts/map-left-out.sh); --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split

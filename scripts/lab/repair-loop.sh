@@ -5,7 +5,8 @@
 # 3.8 alone where MAPPERS is colmap3.8),
 # prunes a copy (PRUNE_ARGS, default --preset disambiguation), maps it, runs `check` on the
 # model, and where check gives `prune --model` something to act on (its report's `repair`: a
-# ghost's blamed pairs, or pairs that place a misplaced group or join clean models) prunes again
+# ghost's blamed pairs, or pairs that place a misplaced group, join clean models or place an
+# image no model registered) prunes again
 # with --model and maps once more. Every model is scored against the ground truth.
 # Prints one row per run and mapper; writes WORKDIR/loop.json.
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at

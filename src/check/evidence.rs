@@ -7,8 +7,10 @@
 //! such a model for two copies (measured on Cup and Books: docs/check.md).
 
 use crate::colmap::database::Database;
+use crate::colmap::ids::camera_model_name;
+use crate::colmap::model::ModelCamera;
 use crate::colmap::sparse::SparseModel;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 
 /// Image names of a pair, in name order.
@@ -26,6 +28,21 @@ pub struct Evidence {
     pub matches: BTreeMap<NamePair, Vec<[u32; 2]>>,
     /// Every image's name, sorted: the capture order where the names sort in it.
     pub images: Vec<String>,
+    /// Images no model registered, as the database has them, read by
+    /// [`Evidence::read_unplaced`] for placing them in a model by their matches
+    /// ([`super::resection::place_unregistered`]). Empty until then.
+    pub unplaced: BTreeMap<String, Unplaced>,
+}
+
+/// What placing an image without a pose needs: its keypoints and its camera.
+#[derive(Clone, Debug)]
+pub struct Unplaced {
+    /// COLMAP's camera_id: the model's camera of that id, refined, is used where it has one.
+    pub camera_id: u32,
+    /// The database's camera (the mapper's starting guess).
+    pub camera: ModelCamera,
+    /// Keypoint positions, by keypoint index.
+    pub keypoints: Vec<[f64; 2]>,
 }
 
 impl Evidence {
@@ -68,7 +85,60 @@ impl Evidence {
             pairs,
             matches,
             images,
+            unplaced: BTreeMap::new(),
         })
+    }
+
+    /// The images with a verified pair of at least `min_num_matches` inliers, pruned or not,
+    /// that no model of `models` registered, in name order: the cameras a user lost, whether
+    /// the mapper failed to register them or a selection left them out. The repair places them
+    /// by their matches ([`super::resection::place_unregistered`]).
+    pub fn lost(&self, models: &[SparseModel], min_num_matches: usize) -> Vec<String> {
+        let matched = self.matches.iter().map(|(pair, m)| (pair, m.len()));
+        not_registered(models, matched, min_num_matches)
+    }
+
+    /// Reads the keypoints and camera of each image of `names` from `db` into
+    /// [`Evidence::unplaced`] (only these: a large database's keypoints are not all needed).
+    pub fn read_unplaced<'a>(
+        &mut self,
+        db: &Database,
+        names: impl IntoIterator<Item = &'a String>,
+    ) -> Result<()> {
+        let images: BTreeMap<String, _> = (db.images()?.into_iter())
+            .map(|im| (im.name.clone(), im))
+            .collect();
+        let cameras: BTreeMap<u32, _> = (db.cameras()?.into_iter())
+            .map(|c| (c.camera_id, c))
+            .collect();
+        for name in names {
+            let image = images
+                .get(name)
+                .with_context(|| format!("no image `{name}`"))?;
+            let c = cameras.get(&image.camera_id).with_context(|| {
+                format!(
+                    "image {name} names camera {}, which the database lacks",
+                    image.camera_id
+                )
+            })?;
+            let camera = ModelCamera {
+                camera_id: c.camera_id,
+                model: camera_model_name(c.model_id).unwrap_or("?").to_string(),
+                width: c.width,
+                height: c.height,
+                params: c.params.clone(),
+            };
+            let keypoints = (db.keypoints_xy(image.image_id)?.into_iter())
+                .map(|[x, y]| [f64::from(x), f64::from(y)])
+                .collect();
+            let unplaced = Unplaced {
+                camera_id: image.camera_id,
+                camera,
+                keypoints,
+            };
+            self.unplaced.insert(name.clone(), unplaced);
+        }
+        Ok(())
     }
 
     /// The images that a pair a mapper would use (at least `min_num_matches` inliers) links and
@@ -79,17 +149,28 @@ impl Evidence {
     /// second run on these images alone starts one (README; docs/check.md, "Pieces that start no
     /// model"). COLMAP 4's incremental mapper relaxes while images are left over.
     pub fn unregistered(&self, models: &[SparseModel], min_num_matches: usize) -> Vec<String> {
-        let registered: HashSet<&str> = (models.iter())
-            .flat_map(|m| &m.images)
-            .map(|im| im.image.name.as_str())
-            .collect();
-        let linked: BTreeSet<&String> = (self.pairs.iter())
-            .filter(|(_, &inliers)| inliers >= min_num_matches)
-            .flat_map(|((a, b), _)| [a, b])
-            .collect();
-        (linked.into_iter())
-            .filter(|name| !registered.contains(name.as_str()))
-            .cloned()
-            .collect()
+        let linked = self.pairs.iter().map(|(pair, &inliers)| (pair, inliers));
+        not_registered(models, linked, min_num_matches)
     }
+}
+
+/// The images of the `pairs` (with their inliers) of at least `min_num_matches` inliers that no
+/// model of `models` registered, in name order.
+fn not_registered<'a>(
+    models: &[SparseModel],
+    pairs: impl Iterator<Item = (&'a NamePair, usize)>,
+    min_num_matches: usize,
+) -> Vec<String> {
+    let registered: HashSet<&str> = (models.iter())
+        .flat_map(|m| &m.images)
+        .map(|im| im.image.name.as_str())
+        .collect();
+    let linked: BTreeSet<&String> = pairs
+        .filter(|(_, inliers)| *inliers >= min_num_matches)
+        .flat_map(|((a, b), _)| [a, b])
+        .collect();
+    (linked.into_iter())
+        .filter(|name| !registered.contains(name.as_str()))
+        .cloned()
+        .collect()
 }

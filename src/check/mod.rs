@@ -443,6 +443,9 @@ pub struct ModelEvidence {
     /// ([`resection::ImagePlacement::holding`]), per pair in name order: `prune --model` drops
     /// them from the pairs it keeps. Sorted.
     pub dropped: Vec<resection::PairMatches>,
+    /// The pairs that place an image no model registered in a clean model
+    /// ([`resection::Rejoin`]): kept unless a ghost of any run blamed them. Sorted.
+    pub rejoin: Vec<[String; 2]>,
 }
 
 /// The check of a mapper's output: each model's (with its misplaced group, if any), and the
@@ -452,6 +455,8 @@ pub struct RunCheck<'e> {
     pub models: Vec<ModelCheck<'e>>,
     /// The clean models the database's matches place in one frame ([`join`]).
     pub joins: Vec<join::Join>,
+    /// The images no model registered that their matches place in a clean model.
+    pub rejoined: Vec<resection::Rejoin>,
 }
 
 /// Checks every model of one mapper run and, with `evidence`, places the two groups of each
@@ -513,10 +518,52 @@ pub fn check_run<'e>(
         }
         None => Vec::new(),
     };
+    let rejoined = match evidence {
+        Some(e) => rejoin(models, &checks, e)?,
+        None => Vec::new(),
+    };
     Ok(RunCheck {
         models: checks,
         joins,
+        rejoined,
     })
+}
+
+/// Each image of [`Evidence::unplaced`] that no model of `models` registered, placed in the
+/// clean model whose points most of its matches agree with ([`resection::place_unregistered`]);
+/// a ghosted or misplaced model is no frame to place it in.
+fn rejoin(
+    models: &[SparseModel],
+    checks: &[ModelCheck],
+    evidence: &Evidence,
+) -> Result<Vec<resection::Rejoin>> {
+    let registered: BTreeSet<&str> = (models.iter())
+        .flat_map(|m| &m.images)
+        .map(|im| im.image.name.as_str())
+        .collect();
+    let unplaced: Vec<_> = (evidence.unplaced.iter())
+        .filter(|(name, _)| !registered.contains(name.as_str()))
+        .collect();
+    let clean: Vec<_> = (models.iter().zip(checks).enumerate())
+        .filter(|(_, (_, c))| !c.wrong())
+        .filter_map(|(k, (m, c))| Some((k, m, c.views.as_ref()?)))
+        .collect();
+    let placed = unplaced
+        .par_iter()
+        .map(|(name, image)| {
+            let mut best: Option<resection::Rejoin> = None;
+            for &model in &clean {
+                let found = resection::place_unregistered(model, name, image, evidence)?;
+                if let Some(r) =
+                    found.filter(|r| best.as_ref().is_none_or(|b| r.support > b.support))
+                {
+                    best = Some(r);
+                }
+            }
+            Ok(best)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(placed.into_iter().flatten().collect())
 }
 
 impl RunCheck<'_> {
@@ -596,9 +643,13 @@ impl RunCheck<'_> {
             let (a, b) = (l.image1.clone(), l.image2.clone());
             links.insert(if a < b { [a, b] } else { [b, a] });
         }
+        let rejoin = (self.rejoined.iter())
+            .flat_map(|r| r.links.iter().cloned())
+            .collect::<BTreeSet<_>>();
         ModelEvidence {
             blamed: blamed.into_iter().collect(),
             links: links.into_iter().collect(),
+            rejoin: rejoin.into_iter().collect(),
             dropped: (dropped.into_iter())
                 .map(|(images, m)| resection::PairMatches {
                     images,
@@ -683,26 +734,34 @@ fn blames(p: &JoiningPair, alone: bool) -> bool {
     p.shared_points > 0 && (!alone || p.matches_joined >= p.matches_apart)
 }
 
-/// The repair's evidence from the repair loop's runs `dirs` (model folders or mappers'
-/// output_paths, in the order they ran; `option` names them in errors), each checked with the
-/// database's `evidence` after the ghosts of the runs before it ([`RunCheck::glued`]): each
-/// run's evidence, and the ghosts of them all for a later run's joins.
-pub fn loop_evidence(
-    dirs: &[std::path::PathBuf],
-    option: &str,
-    evidence: &Evidence,
-    settings: &CheckSettings,
-) -> Result<(Vec<ModelEvidence>, Vec<join::Glued>)> {
+/// The models of each of the repair loop's runs `dirs` (model folders or mappers'
+/// output_paths; `option` names them in errors).
+pub fn read_runs(dirs: &[std::path::PathBuf], option: &str) -> Result<Vec<Vec<SparseModel>>> {
     let read = |dir: &std::path::Path| -> Result<Vec<SparseModel>> {
         let dirs = crate::colmap::model::model_dirs(dir)?;
         dirs.iter()
             .map(|d| crate::colmap::sparse::read_sparse_model(d))
             .collect()
     };
+    (dirs.iter())
+        .map(|dir| read(dir).with_context(|| format!("reading {option} {}", dir.display())))
+        .collect()
+}
+
+/// The repair's evidence from the repair loop's runs (`runs`, read from `dirs` in the order
+/// they ran; `option` names them in errors), each checked with the database's `evidence`
+/// after the ghosts of the runs before it ([`RunCheck::glued`]): each run's evidence, and the
+/// ghosts of them all for a later run's joins.
+pub fn loop_evidence(
+    dirs: &[std::path::PathBuf],
+    runs: &[Vec<SparseModel>],
+    option: &str,
+    evidence: &Evidence,
+    settings: &CheckSettings,
+) -> Result<(Vec<ModelEvidence>, Vec<join::Glued>)> {
     let (mut found, mut earlier) = (Vec::new(), Vec::new());
-    for dir in dirs {
-        let run = read(dir)
-            .and_then(|models| check_run(&models, Some(evidence), settings, &earlier))
+    for (dir, models) in dirs.iter().zip(runs) {
+        let run = check_run(models, Some(evidence), settings, &earlier)
             .with_context(|| format!("checking {option} {}", dir.display()))?;
         found.push(run.evidence());
         earlier.extend(run.glued());

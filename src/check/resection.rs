@@ -8,14 +8,17 @@
 //! matches, pruned or not, place it back. The pairs that agree with that pose are the links
 //! `prune --model` keeps; those that agree with the model's pose instead are blamed.
 
+use super::evidence::{Evidence, Unplaced};
 use super::join::{spread_of, MISPLACED_DISTANCE};
-use super::views::Views;
+use super::views::{Intrinsics, Views};
+use crate::colmap::sparse::SparseModel;
 use anyhow::Result;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use opencv::core::{Mat, Point2d, Point3d, Vector};
 use opencv::prelude::*;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// A correspondence agrees with a pose when the pose projects its 3D point within this many
 /// pixels of its keypoint: COLMAP's mapper filters observations at 4 px
@@ -170,6 +173,97 @@ pub fn misplaced_images(views: &Views) -> Result<Vec<ImagePlacement>> {
     Ok(placed)
 }
 
+/// Where the matches of an image no model registered place it in a model: a mapper that lost
+/// it (a group tied to the rest by too few matches once a selection kept only its strongest
+/// pairs: lego, 8 of 100 images with COLMAP 3.8) can register it through the pairs that agree.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Rejoin {
+    /// Image name.
+    pub image: String,
+    /// The model it is placed in, as an index of the checked folders.
+    pub model: usize,
+    /// Its correspondences: its keypoints matched, pruned or not, to keypoints on a point of
+    /// the model.
+    pub correspondences: usize,
+    /// Those the pose projects within [`AGREE_PX`].
+    pub support: usize,
+    /// The pairs (this image, another) with at least [`PAIR_MIN_CORRESPONDENCES`]
+    /// correspondences, at least half of them agreeing with the pose: `prune --model` keeps
+    /// them.
+    pub links: Vec<[String; 2]>,
+}
+
+/// Places `name`, which no model registered, in model `k` (`views` of `model`) by its
+/// matches to keypoints on the model's points, through the model's camera of its camera_id
+/// (refined) or else the database's: the pose most of them agree with, where at least
+/// [`MIN_SUPPORT`] do (COLMAP's mapper registers an image with 30 inliers,
+/// `abs_pose_min_num_inliers`).
+pub fn place_unregistered(
+    (k, model, views): (usize, &SparseModel, &Views),
+    name: &str,
+    unplaced: &Unplaced,
+    evidence: &Evidence,
+) -> Result<Option<Rejoin>> {
+    let mut c = Vec::new();
+    for (w, view) in views.views.iter().enumerate() {
+        let first = name < view.name.as_str();
+        let key = match first {
+            true => (name.to_string(), view.name.clone()),
+            false => (view.name.clone(), name.to_string()),
+        };
+        for &[x, y] in evidence.matches.get(&key).map_or(&[][..], Vec::as_slice) {
+            let (ku, kw) = if first { (x, y) } else { (y, x) };
+            let xy = unplaced.keypoints.get(ku as usize);
+            if let (Some(xy), Some(Some(point))) = (xy, view.point_of.get(kw as usize)) {
+                let (xy, point, matched) = (*xy, *point, Some([ku, kw]));
+                c.push(Correspondence {
+                    xy,
+                    point,
+                    view: w,
+                    matched,
+                });
+            }
+        }
+    }
+    if c.len() < MIN_SUPPORT {
+        return Ok(None);
+    }
+    let camera = (model.cameras.iter()).find(|c| c.camera_id == unplaced.camera_id);
+    let intrinsics = Intrinsics::from_camera(camera.unwrap_or(&unplaced.camera));
+    let Some((rotation, translation)) = pnp(views, &intrinsics, &c)? else {
+        return Ok(None);
+    };
+    // Per other view: correspondences, and those agreeing with the pose.
+    let mut per_view: BTreeMap<usize, [usize; 2]> = BTreeMap::new();
+    for k in &c {
+        let agrees = (intrinsics.project(&(rotation * views.points[k.point] + translation)))
+            .is_some_and(|q| (q[0] - k.xy[0]).hypot(q[1] - k.xy[1]) <= AGREE_PX);
+        let counts = per_view.entry(k.view).or_default();
+        *counts = [counts[0] + 1, counts[1] + usize::from(agrees)];
+    }
+    let support = per_view.values().map(|n| n[1]).sum();
+    if support < MIN_SUPPORT {
+        return Ok(None);
+    }
+    let mut links = Vec::new();
+    for (w, [n, s]) in per_view {
+        if n >= PAIR_MIN_CORRESPONDENCES && 2 * s >= n {
+            let other = views.views[w].name.clone();
+            links.push(match name < other.as_str() {
+                true => [name.to_string(), other],
+                false => [other, name.to_string()],
+            });
+        }
+    }
+    Ok(Some(Rejoin {
+        image: name.to_string(),
+        model: k,
+        correspondences: c.len(),
+        support,
+        links,
+    }))
+}
+
 /// A world-to-camera rotation and translation.
 type Pose = (Matrix3<f64>, Vector3<f64>);
 
@@ -180,7 +274,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
         return Ok(None);
     }
     let view = &views.views[v];
-    let Some((rotation, translation)) = pnp(views, v, &c)? else {
+    let Some((rotation, translation)) = pnp(views, &view.intrinsics, &c)? else {
         return Ok(None);
     };
     let error = |r: &Matrix3<f64>, t: &Vector3<f64>, k: &Correspondence| {
@@ -239,10 +333,10 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
     }))
 }
 
-/// The pose of view `v` most correspondences `c` agree with: world-to-camera rotation and
-/// translation, from OpenCV's RANSAC (deterministic: its generator starts from a fixed state).
-fn pnp(views: &Views, v: usize, c: &[Correspondence]) -> Result<Option<Pose>> {
-    let i = &views.views[v].intrinsics;
+/// The pose most correspondences `c` (to `views`' points, through intrinsics `i`) agree with:
+/// world-to-camera rotation and translation, from OpenCV's RANSAC (deterministic: its
+/// generator starts from a fixed state).
+fn pnp(views: &Views, i: &Intrinsics, c: &[Correspondence]) -> Result<Option<Pose>> {
     let object: Vector<Point3d> = c
         .iter()
         .map(|k| {

@@ -1094,6 +1094,7 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
         RunCheck {
             models: vec![c],
             joins: Vec::new(),
+            rejoined: Vec::new(),
         }
         .evidence()
     };
@@ -1288,4 +1289,80 @@ fn images_a_usable_pair_links_and_no_model_registered_are_unregistered() {
         ["0013.png", "0014.png", "0015.png"]
     );
     assert!(Evidence::default().unregistered(&models, 15).is_empty());
+}
+
+/// Image 12 of `model` taken out of it, as a mapper that lost it leaves it: the model without
+/// it, the evidence with its keypoints, its true pairs to images 6 to 11, and a pair to image 1
+/// whose matches are the look of other points.
+fn lost_image(mut model: SparseModel) -> (SparseModel, Evidence) {
+    let lost = model.images.pop().expect("12 images");
+    let mut evidence = Evidence::default();
+    for a in &model.images[5..] {
+        add_pair(&mut evidence, a, &lost, matches_of(a, &lost, |id| id));
+    }
+    add_pair(
+        &mut evidence,
+        &model.images[0],
+        &lost,
+        refused_matches(&model.images[0], &lost),
+    );
+    let unplaced = evidence::Unplaced {
+        camera_id: 1,
+        camera: camera(),
+        keypoints: lost.points2d.iter().map(|p| p.xy).collect(),
+    };
+    evidence.unplaced.insert(lost.image.name.clone(), unplaced);
+    (model, evidence)
+}
+
+/// An image no model registered is placed by its matches to the model's points: the pairs
+/// that agree with the pose are the repair's (kept by `prune --model`), the pair of false
+/// matches is not; a model the check finds wrong is no frame to place it in.
+#[test]
+fn an_image_the_mapper_lost_is_placed_by_its_true_pairs() {
+    fn run_of<'e>(model: &SparseModel, evidence: &'e Evidence) -> RunCheck<'e> {
+        let models = std::slice::from_ref(model);
+        check_run(models, Some(evidence), &DEFAULT_SETTINGS, &[]).unwrap()
+    }
+    let (model, evidence) = lost_image(correct_model());
+    let run = run_of(&model, &evidence);
+    assert!(!run.models[0].wrong());
+    let [r] = &run.rejoined[..] else {
+        panic!("one image placed: {:?}", run.rejoined)
+    };
+    assert_eq!((r.image.as_str(), r.model), ("0012.png", 0));
+    let true_pairs: Vec<[String; 2]> = (6..12).map(|a| image_pair(a, 12)).collect();
+    assert_eq!(r.links, true_pairs);
+    assert!(r.support >= resection::MIN_SUPPORT && r.support < r.correspondences);
+    assert_eq!(run.evidence().rejoin, true_pairs);
+    // Without the image's keypoints there is nothing to place.
+    let mut unread = evidence.clone();
+    unread.unplaced.clear();
+    assert!(run_of(&model, &unread).rejoined.is_empty());
+
+    let (ghost, ghost_evidence) = lost_image(ghosted_model());
+    let run = run_of(&ghost, &ghost_evidence);
+    assert!(run.models[0].ghosted);
+    assert!(run.rejoined.is_empty());
+}
+
+/// Lost are the images with a verified pair of enough inliers that no model registered,
+/// whether a prune invalidated their pairs (the selection left them out) or not.
+#[test]
+fn images_with_verified_pairs_and_no_model_are_lost_even_where_a_prune_left_them_out() {
+    let models = [correct_model()];
+    let pair = |a: &str, b: &str| (a.to_string(), b.to_string());
+    let mut evidence = Evidence::default();
+    for (a, b, n, valid) in [
+        ("0001.png", "0013.png", 20, true),
+        ("0002.png", "0014.png", 20, false),
+        ("0002.png", "0015.png", 14, false),
+    ] {
+        evidence.matches.insert(pair(a, b), vec![[0, 0]; n]);
+        if valid {
+            evidence.pairs.insert(pair(a, b), n);
+        }
+    }
+    assert_eq!(evidence.unregistered(&models, 15), ["0013.png"]);
+    assert_eq!(evidence.lost(&models, 15), ["0013.png", "0014.png"]);
 }

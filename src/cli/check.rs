@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use vgsel_colmap::check::evidence::Evidence;
+use vgsel_colmap::check::resection::Rejoin;
 use vgsel_colmap::check::{self, CheckSettings, ModelCheck, DEFAULT_SETTINGS};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
@@ -237,25 +238,17 @@ fn examples<'a>(pairs: impl Iterator<Item = (&'a String, &'a String)>) -> String
         .join(" ")
 }
 
-/// The images the database links and no model registered (none without the database): a line
-/// where there are any, and the list written to `path` (`--unregistered`).
-fn unregistered(
-    evidence: Option<&Evidence>,
-    models: &[SparseModel],
-    path: Option<&Path>,
-) -> Result<Vec<String>> {
-    let names = match evidence {
-        Some(e) => e.unregistered(models, DEFAULT_MIN_NUM_MATCHES),
-        None => Vec::new(),
-    };
+/// The images the database links and no model registered: a line where there are any, and the
+/// list written to `path` (`--unregistered`).
+fn print_unregistered(names: &[String], path: Option<&Path>) -> Result<()> {
     if !names.is_empty() {
-        println!("{}", unregistered_line(&names));
+        println!("{}", unregistered_line(names));
     }
     if let Some(path) = path {
         let lines: String = names.iter().map(|n| format!("{n}\n")).collect();
         std::fs::write(path, lines).with_context(|| format!("writing {}", path.display()))?;
     }
-    Ok(names)
+    Ok(())
 }
 
 /// The ghosts of the `--earlier_model` folders, each checked after the ones before it (as
@@ -266,25 +259,52 @@ fn earlier_ghosts(
     settings: &CheckSettings,
 ) -> Result<Vec<check::join::Glued>> {
     match evidence {
-        Some(e) => Ok(check::loop_evidence(dirs, "--earlier_model", e, settings)?.1),
+        Some(e) => {
+            let runs = check::read_runs(dirs, "--earlier_model")?;
+            Ok(check::loop_evidence(dirs, &runs, "--earlier_model", e, settings)?.1)
+        }
         None => Ok(Vec::new()),
     }
 }
 
 /// The line for images the database links and no model registered (at least one).
 fn unregistered_line(names: &[String]) -> String {
+    format!(
+        "{} images the database's pairs link are in no model: {} (with COLMAP 3.8, map them \
+         on their own: --unregistered FILE, then colmap mapper --image_list_path FILE)",
+        names.len(),
+        listed(names)
+    )
+}
+
+/// The line for the images no model registered that their matches place in a clean model
+/// through pairs the database does not offer (`lacked`); none without such a pair.
+fn rejoined_line(rejoined: &[Rejoin], lacked: &[[String; 2]]) -> Option<String> {
+    let placed: Vec<String> = (rejoined.iter())
+        .filter(|r| r.links.iter().any(|p| lacked.contains(p)))
+        .map(|r| r.image.clone())
+        .collect();
+    (!placed.is_empty()).then(|| {
+        format!(
+            "{} images no model registered are placed by their matches in a clean model: {} \
+             (prune --model keeps the {} pairs that place them, which this database does not \
+             offer)",
+            placed.len(),
+            listed(&placed),
+            lacked.len()
+        )
+    })
+}
+
+/// The first five of `names`, and `...` for more.
+fn listed(names: &[String]) -> String {
     let shown: Vec<&str> = names.iter().take(5).map(String::as_str).collect();
     let more = if names.len() > shown.len() {
         " ..."
     } else {
         ""
     };
-    format!(
-        "{} images the database's pairs link are in no model: {}{more} (with COLMAP 3.8, map them \
-         on their own: --unregistered FILE, then colmap mapper --image_list_path FILE)",
-        names.len(),
-        shown.join(" ")
-    )
+    format!("{}{more}", shown.join(" "))
 }
 
 /// The line a join gets: the two models, how many pairs link them and how well they agree.
@@ -304,18 +324,26 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
     )
 }
 
-/// Runs the check; Ok(true) when some model is wrong (ghosted, misplaced or unanchored).
-/// `quiet` silences the note on stderr; `progress` shows the stages (a large model's check
-/// takes minutes).
-pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
-    let settings = args.settings();
-    let evidence = match &args.database_path {
-        Some(path) => {
-            progress.stage("reading the database's matches");
-            Some(Evidence::load(&Database::open_read_only(path)?)?)
-        }
+/// What the check reads: the model folders, their models, the database's evidence (with the
+/// images no model registered read for placing them) and the images the database links that
+/// no model registered.
+struct Inputs {
+    dirs: Vec<PathBuf>,
+    models: Vec<SparseModel>,
+    evidence: Option<Evidence>,
+    unregistered: Vec<String>,
+}
+
+/// Reads the check's [`Inputs`]; `quiet` silences the note without a database.
+fn read_inputs(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<Inputs> {
+    let db = match &args.database_path {
+        Some(path) => Some(Database::open_read_only(path)?),
         None => None,
     };
+    if db.is_some() {
+        progress.stage("reading the database's matches");
+    }
+    let mut evidence = db.as_ref().map(Evidence::load).transpose()?;
     if evidence.is_none() && !quiet {
         eprintln!(
             "vgsel-colmap check: note: without --database_path, a surface that a sparse \
@@ -334,6 +362,31 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
         .iter()
         .map(|dir| read_sparse_model(dir))
         .collect::<Result<Vec<_>>>()?;
+    let mut unregistered = Vec::new();
+    if let (Some(e), Some(db)) = (&mut evidence, &db) {
+        unregistered = e.unregistered(&models, DEFAULT_MIN_NUM_MATCHES);
+        let lost = e.lost(&models, DEFAULT_MIN_NUM_MATCHES);
+        e.read_unplaced(db, &lost)?;
+    }
+    Ok(Inputs {
+        dirs,
+        models,
+        evidence,
+        unregistered,
+    })
+}
+
+/// Runs the check; Ok(true) when some model is wrong (ghosted, misplaced or unanchored).
+/// `quiet` silences the note on stderr; `progress` shows the stages (a large model's check
+/// takes minutes).
+pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
+    let settings = args.settings();
+    let Inputs {
+        dirs,
+        models,
+        evidence,
+        unregistered,
+    } = read_inputs(args, quiet, progress)?;
     let images: usize = models.iter().map(|m| m.images.len()).sum();
     progress.stage(&format!("checking {images} registered images"));
     let earlier = earlier_ghosts(&args.earlier_model, evidence.as_ref(), &settings)?;
@@ -367,7 +420,18 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             .into();
         joined.push(value);
     }
-    let unregistered = unregistered(evidence.as_ref(), &models, args.unregistered.as_deref())?;
+    // What a repair turn would change: pairs that place a lost image and that the mapper
+    // already had are no news (a turn would repeat the run), so the loop stops there.
+    let mut repair = run.evidence();
+    if let Some(e) = &evidence {
+        repair
+            .rejoin
+            .retain(|[a, b]| !e.pairs.contains_key(&(a.clone(), b.clone())));
+    }
+    print_unregistered(&unregistered, args.unregistered.as_deref())?;
+    if let Some(line) = rejoined_line(&run.rejoined, &repair.rejoin) {
+        println!("{line}");
+    }
     if let Some(path) = &args.report {
         let report = serde_json::json!({
             "ghosted": ghosted,
@@ -378,7 +442,8 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             "models": reports,
             "joins": joined,
             "unregistered": unregistered,
-            "repair": run.evidence(),
+            "rejoined": run.rejoined,
+            "repair": repair,
         });
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
             .with_context(|| format!("writing {}", path.display()))?;

@@ -115,6 +115,8 @@ pub struct ModelFolder {
     /// The matches that held its misplaced images where the mapper put them: dropped from
     /// the pairs kept.
     pub dropped: Vec<PairMatches>,
+    /// The pairs that place an image no model registered: kept unless a folder blamed them.
+    pub rejoin: NameList,
 }
 
 /// The overrides as listed in the report, by image name.
@@ -137,6 +139,10 @@ pub struct Listed {
     /// without `--model`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model_links: Option<Vec<[String; 2]>>,
+    /// Pairs that place an image no model registered (`--model`), kept unless a folder blamed
+    /// them or the user forbade them; absent without `--model`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_rejoins: Option<Vec<[String; 2]>>,
 }
 
 /// Overrides resolved against a view graph.
@@ -307,6 +313,20 @@ impl Resolved {
         let [(blamed, _), (linked, _)] = listed;
         self.listed.model_conflicts = Some(blamed);
         self.listed.model_links = Some(linked);
+        // An image the mapper lost is placed from its matches, which may be a ghost's: its
+        // pairs are kept only where no run blamed them, and never over a link's decision.
+        let mut rejoins = BTreeSet::new();
+        for folder in folders {
+            let list = &folder.rejoin;
+            for (line, entry) in &list.entries {
+                match names.edge(list, *line, entry)? {
+                    Some(k) if self.edges[k] == ArcRule::Free => self.edges[k] = ArcRule::Fixed,
+                    _ => continue,
+                }
+                rejoins.insert([entry[0].clone(), entry[1].clone()]);
+            }
+        }
+        self.listed.model_rejoins = Some(rejoins.into_iter().collect());
         for (folder, pair) in folders
             .iter()
             .flat_map(|f| f.dropped.iter().map(move |p| (f, p)))
@@ -460,6 +480,7 @@ mod tests {
             blamed: list(path, blamed),
             links: list(path, links),
             dropped: Vec::new(),
+            rejoin: list(path, Vec::new()),
         }
     }
 
@@ -576,6 +597,40 @@ mod tests {
         overrides.forbid_pairs = Some(list("forbid.txt", vec![vec![name(2), name(3)]]));
         let resolved = overrides.resolve(&images, &graph, 15).unwrap();
         assert_eq!(resolved.edges[1], ArcRule::Removed);
+    }
+
+    /// The pairs that place an image the mapper lost are kept where no folder decided them,
+    /// whichever folder placed it: a pair any folder blamed stays out (its matches may be a
+    /// ghost's), and the user's `--forbid_pairs` wins. Only the pairs kept are listed.
+    #[test]
+    fn pairs_that_place_a_lost_image_are_kept_unless_a_ghost_blamed_them() {
+        let (images, graph) = four_in_a_row();
+        let name = |id: u32| images[id as usize - 1].name.clone();
+        let mut placed = folder("sparse2", vec![], vec![]);
+        placed.rejoin = list(
+            "sparse2",
+            vec![
+                vec![name(1), name(2)],
+                vec![name(2), name(3)],
+                vec![name(1), name(4)],
+            ],
+        );
+        let mut overrides = Overrides {
+            model: vec![
+                placed,
+                folder("sparse3", vec![vec![name(2), name(3)]], vec![]),
+            ],
+            ..Overrides::default()
+        };
+        let resolved = overrides.resolve(&images, &graph, 15).unwrap();
+        assert_eq!(
+            resolved.edges,
+            [ArcRule::Fixed, ArcRule::Removed, ArcRule::Free]
+        );
+        assert_eq!(resolved.listed.model_rejoins.unwrap(), [[name(1), name(2)]]);
+        overrides.forbid_pairs = Some(list("forbid.txt", vec![vec![name(2), name(1)]]));
+        let resolved = overrides.resolve(&images, &graph, 15).unwrap();
+        assert_eq!(resolved.edges[0], ArcRule::Removed);
     }
 
     #[test]

@@ -18,6 +18,7 @@ use crate::selection::preset::Preset;
 use crate::selection::track_completion::Needs;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 /// COLMAP's default `--Mapper.min_num_matches`: fewer verified inliers make no view-graph edge.
@@ -194,10 +195,17 @@ impl Parameters {
         let rules = &self.arc_rules;
         let mut model = Vec::new();
         if !rules.model.is_empty() {
-            // The database's side of the check, read once for every --model folder.
-            let evidence = check::evidence::Evidence::load(db)?;
+            // The database's side of the check, read once for every --model folder, with the
+            // images each run lost.
+            let mut evidence = check::evidence::Evidence::load(db)?;
+            let runs = check::read_runs(&rules.model, "--model")?;
+            let lost: BTreeSet<String> = (runs.iter())
+                .flat_map(|models| evidence.lost(models, self.min_num_matches))
+                .collect();
+            evidence.read_unplaced(db, &lost)?;
             let settings = &check::DEFAULT_SETTINGS;
-            let (found, _) = check::loop_evidence(&rules.model, "--model", &evidence, settings)?;
+            let (found, _) =
+                check::loop_evidence(&rules.model, &runs, "--model", &evidence, settings)?;
             for (dir, found) in rules.model.iter().zip(found) {
                 let list = |pairs: Vec<[String; 2]>| NameList {
                     path: dir.to_path_buf(),
@@ -211,6 +219,7 @@ impl Parameters {
                     blamed: list(found.blamed),
                     links: list(found.links),
                     dropped: found.dropped,
+                    rejoin: list(found.rejoin),
                 });
             }
         }
