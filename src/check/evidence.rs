@@ -43,6 +43,9 @@ pub struct Unplaced {
     pub camera: ModelCamera,
     /// Keypoint positions, by keypoint index.
     pub keypoints: Vec<[f64; 2]>,
+    /// Its verified matches, pruned or not, per other image: (this image's keypoint, the
+    /// other's).
+    pub matches: Vec<(String, Vec<[u32; 2]>)>,
 }
 
 impl Evidence {
@@ -135,10 +138,25 @@ impl Evidence {
                 camera_id: image.camera_id,
                 camera,
                 keypoints,
+                matches: Vec::new(),
             };
             self.unplaced.insert(name.clone(), unplaced);
         }
+        self.gather_unplaced_matches();
         Ok(())
+    }
+
+    /// Fills each [`Unplaced`]'s matches from [`Evidence::matches`], in one pass.
+    pub(crate) fn gather_unplaced_matches(&mut self) {
+        for ((a, b), m) in &self.matches {
+            if let Some(u) = self.unplaced.get_mut(a) {
+                u.matches.push((b.clone(), m.clone()));
+            }
+            if let Some(u) = self.unplaced.get_mut(b) {
+                u.matches
+                    .push((a.clone(), m.iter().map(|&[x, y]| [y, x]).collect()));
+            }
+        }
     }
 
     /// The images that a pair a mapper would use (at least `min_num_matches` inliers) links and

@@ -546,14 +546,14 @@ fn rejoin(
         .collect();
     let clean: Vec<_> = (models.iter().zip(checks).enumerate())
         .filter(|(_, (_, c))| !c.wrong())
-        .filter_map(|(k, (m, c))| Some((k, m, c.views.as_ref()?)))
+        .filter_map(|(k, (m, c))| Some(resection::Frame::new(k, m, c.views.as_ref()?)))
         .collect();
     let placed = unplaced
         .par_iter()
         .map(|(name, image)| {
             let mut best: Option<resection::Rejoin> = None;
-            for &model in &clean {
-                let found = resection::place_unregistered(model, name, image, evidence)?;
+            for frame in &clean {
+                let found = resection::place_unregistered(frame, name, image)?;
                 if let Some(r) =
                     found.filter(|r| best.as_ref().is_none_or(|b| r.support > b.support))
                 {

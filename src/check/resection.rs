@@ -8,7 +8,7 @@
 //! matches, pruned or not, place it back. The pairs that agree with that pose are the links
 //! `prune --model` keeps; those that agree with the model's pose instead are blamed.
 
-use super::evidence::{Evidence, Unplaced};
+use super::evidence::Unplaced;
 use super::join::{spread_of, MISPLACED_DISTANCE};
 use super::views::{Intrinsics, Views};
 use crate::colmap::sparse::SparseModel;
@@ -18,7 +18,7 @@ use opencv::core::{Mat, Point2d, Point3d, Vector};
 use opencv::prelude::*;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// A correspondence agrees with a pose when the pose projects its 3D point within this many
 /// pixels of its keypoint: COLMAP's mapper filters observations at 4 px
@@ -193,28 +193,54 @@ pub struct Rejoin {
     pub links: Vec<[String; 2]>,
 }
 
-/// Places `name`, which no model registered, in model `k` (`views` of `model`) by its
-/// matches to keypoints on the model's points, through the model's camera of its camera_id
-/// (refined) or else the database's: the pose most of them agree with, where at least
-/// [`MIN_SUPPORT`] do (COLMAP's mapper registers an image with 30 inliers,
-/// `abs_pose_min_num_inliers`).
+/// A clean model to place lost images in: its index among the checked folders, the model, its
+/// views, and each view's index by image name.
+pub struct Frame<'a> {
+    /// The model's index among the checked folders.
+    pub k: usize,
+    /// The model (its cameras).
+    pub model: &'a SparseModel,
+    /// Its views (the points and keypoints on them).
+    pub views: &'a Views<'a>,
+    /// Each view's index, by image name.
+    index: HashMap<&'a str, usize>,
+}
+
+impl<'a> Frame<'a> {
+    /// Model `k` with its views.
+    pub fn new(k: usize, model: &'a SparseModel, views: &'a Views<'a>) -> Frame<'a> {
+        let index = (views.views.iter().enumerate())
+            .map(|(w, v)| (v.name.as_str(), w))
+            .collect();
+        Frame {
+            k,
+            model,
+            views,
+            index,
+        }
+    }
+}
+
+/// Places `name`, which no model registered, in `frame` by its matches to keypoints on the
+/// model's points, through the model's camera of its camera_id (refined) or else the
+/// database's: the pose most of them agree with, where at least [`MIN_SUPPORT`] do (COLMAP's
+/// mapper registers an image with 30 inliers, `abs_pose_min_num_inliers`).
 pub fn place_unregistered(
-    (k, model, views): (usize, &SparseModel, &Views),
+    frame: &Frame,
     name: &str,
     unplaced: &Unplaced,
-    evidence: &Evidence,
 ) -> Result<Option<Rejoin>> {
+    let views = frame.views;
+    // In view order, as a registered image's correspondences are (the RANSAC's draws follow it).
+    let mut matched: Vec<(usize, &[[u32; 2]])> = (unplaced.matches.iter())
+        .filter_map(|(other, m)| Some((*frame.index.get(other.as_str())?, m.as_slice())))
+        .collect();
+    matched.sort_unstable_by_key(|&(w, _)| w);
     let mut c = Vec::new();
-    for (w, view) in views.views.iter().enumerate() {
-        let first = name < view.name.as_str();
-        let key = match first {
-            true => (name.to_string(), view.name.clone()),
-            false => (view.name.clone(), name.to_string()),
-        };
-        for &[x, y] in evidence.matches.get(&key).map_or(&[][..], Vec::as_slice) {
-            let (ku, kw) = if first { (x, y) } else { (y, x) };
+    for (w, matches) in matched {
+        for &[ku, kw] in matches {
             let xy = unplaced.keypoints.get(ku as usize);
-            if let (Some(xy), Some(Some(point))) = (xy, view.point_of.get(kw as usize)) {
+            if let (Some(xy), Some(Some(point))) = (xy, views.views[w].point_of.get(kw as usize)) {
                 let (xy, point, matched) = (*xy, *point, Some([ku, kw]));
                 c.push(Correspondence {
                     xy,
@@ -228,7 +254,7 @@ pub fn place_unregistered(
     if c.len() < MIN_SUPPORT {
         return Ok(None);
     }
-    let camera = (model.cameras.iter()).find(|c| c.camera_id == unplaced.camera_id);
+    let camera = (frame.model.cameras.iter()).find(|c| c.camera_id == unplaced.camera_id);
     let intrinsics = Intrinsics::from_camera(camera.unwrap_or(&unplaced.camera));
     let Some((rotation, translation)) = pnp(views, &intrinsics, &c)? else {
         return Ok(None);
@@ -257,7 +283,7 @@ pub fn place_unregistered(
     }
     Ok(Some(Rejoin {
         image: name.to_string(),
-        model: k,
+        model: frame.k,
         correspondences: c.len(),
         support,
         links,

@@ -1310,8 +1310,10 @@ fn lost_image(mut model: SparseModel) -> (SparseModel, Evidence) {
         camera_id: 1,
         camera: camera(),
         keypoints: lost.points2d.iter().map(|p| p.xy).collect(),
+        matches: Vec::new(),
     };
     evidence.unplaced.insert(lost.image.name.clone(), unplaced);
+    evidence.gather_unplaced_matches();
     (model, evidence)
 }
 
