@@ -29,14 +29,14 @@ pub struct Evidence {
     /// Every image's name, sorted: the capture order where the names sort in it.
     pub images: Vec<String>,
     /// Images no model registered, as the database has them, read by
-    /// [`Evidence::read_unplaced`] for placing them in a model by their matches
-    /// ([`super::resection::place_unregistered`]). Empty until then.
-    pub unplaced: BTreeMap<String, Unplaced>,
+    /// [`Evidence::read_lost`] for placing them in a model by their matches
+    /// ([`super::resection::place_lost`]). Empty until then.
+    pub lost_images: BTreeMap<String, LostImage>,
 }
 
 /// What placing an image without a pose needs: its keypoints and its camera.
 #[derive(Clone, Debug)]
-pub struct Unplaced {
+pub struct LostImage {
     /// COLMAP's camera_id: the model's camera of that id, refined, is used where it has one.
     pub camera_id: u32,
     /// The database's camera (the mapper's starting guess).
@@ -88,22 +88,22 @@ impl Evidence {
             pairs,
             matches,
             images,
-            unplaced: BTreeMap::new(),
+            lost_images: BTreeMap::new(),
         })
     }
 
     /// The images with a verified pair of at least `min_num_matches` inliers, pruned or not,
     /// that no model of `models` registered, in name order: the cameras a user lost, whether
     /// the mapper failed to register them or a selection left them out. The repair places them
-    /// by their matches ([`super::resection::place_unregistered`]).
+    /// by their matches ([`super::resection::place_lost`]).
     pub fn lost(&self, models: &[SparseModel], min_num_matches: usize) -> Vec<String> {
         let matched = self.matches.iter().map(|(pair, m)| (pair, m.len()));
         not_registered(models, matched, min_num_matches)
     }
 
     /// Reads the keypoints and camera of each image of `names` from `db` into
-    /// [`Evidence::unplaced`] (only these: a large database's keypoints are not all needed).
-    pub fn read_unplaced<'a>(
+    /// [`Evidence::lost_images`] (only these: a large database's keypoints are not all needed).
+    pub fn read_lost<'a>(
         &mut self,
         db: &Database,
         names: impl IntoIterator<Item = &'a String>,
@@ -134,25 +134,25 @@ impl Evidence {
             let keypoints = (db.keypoints_xy(image.image_id)?.into_iter())
                 .map(|[x, y]| [f64::from(x), f64::from(y)])
                 .collect();
-            let unplaced = Unplaced {
+            let lost = LostImage {
                 camera_id: image.camera_id,
                 camera,
                 keypoints,
                 matches: Vec::new(),
             };
-            self.unplaced.insert(name.clone(), unplaced);
+            self.lost_images.insert(name.clone(), lost);
         }
-        self.gather_unplaced_matches();
+        self.gather_lost_matches();
         Ok(())
     }
 
-    /// Fills each [`Unplaced`]'s matches from [`Evidence::matches`], in one pass.
-    pub(crate) fn gather_unplaced_matches(&mut self) {
+    /// Fills each [`LostImage`]'s matches from [`Evidence::matches`], in one pass.
+    pub(crate) fn gather_lost_matches(&mut self) {
         for ((a, b), m) in &self.matches {
-            if let Some(u) = self.unplaced.get_mut(a) {
+            if let Some(u) = self.lost_images.get_mut(a) {
                 u.matches.push((b.clone(), m.clone()));
             }
-            if let Some(u) = self.unplaced.get_mut(b) {
+            if let Some(u) = self.lost_images.get_mut(b) {
                 u.matches
                     .push((a.clone(), m.iter().map(|&[x, y]| [y, x]).collect()));
             }

@@ -529,8 +529,8 @@ pub fn check_run<'e>(
     })
 }
 
-/// Each image of [`Evidence::unplaced`] that no model of `models` registered, placed in the
-/// clean model whose points most of its matches agree with ([`resection::place_unregistered`]);
+/// Each image of [`Evidence::lost_images`] that no model of `models` registered, placed in the
+/// clean model whose points most of its matches agree with ([`resection::place_lost`]);
 /// a ghosted or misplaced model is no frame to place it in.
 fn rejoin(
     models: &[SparseModel],
@@ -541,19 +541,19 @@ fn rejoin(
         .flat_map(|m| &m.images)
         .map(|im| im.image.name.as_str())
         .collect();
-    let unplaced: Vec<_> = (evidence.unplaced.iter())
+    let lost: Vec<_> = (evidence.lost_images.iter())
         .filter(|(name, _)| !registered.contains(name.as_str()))
         .collect();
     let clean: Vec<_> = (models.iter().zip(checks).enumerate())
         .filter(|(_, (_, c))| !c.wrong())
         .filter_map(|(k, (m, c))| Some(resection::Frame::new(k, m, c.views.as_ref()?)))
         .collect();
-    let placed = unplaced
+    let placed = lost
         .par_iter()
         .map(|(name, image)| {
             let mut best: Option<resection::Rejoin> = None;
             for frame in &clean {
-                let found = resection::place_unregistered(frame, name, image)?;
+                let found = resection::place_lost(frame, name, image)?;
                 if let Some(r) =
                     found.filter(|r| best.as_ref().is_none_or(|b| r.support > b.support))
                 {

@@ -8,7 +8,7 @@
 //! matches, pruned or not, place it back. The pairs that agree with that pose are the links
 //! `prune --model` keeps; those that agree with the model's pose instead are blamed.
 
-use super::evidence::Unplaced;
+use super::evidence::LostImage;
 use super::join::{spread_of, MISPLACED_DISTANCE};
 use super::views::{Intrinsics, Views};
 use crate::colmap::sparse::SparseModel;
@@ -225,21 +225,17 @@ impl<'a> Frame<'a> {
 /// model's points, through the model's camera of its camera_id (refined) or else the
 /// database's: the pose most of them agree with, where at least [`MIN_SUPPORT`] do (COLMAP's
 /// mapper registers an image with 30 inliers, `abs_pose_min_num_inliers`).
-pub fn place_unregistered(
-    frame: &Frame,
-    name: &str,
-    unplaced: &Unplaced,
-) -> Result<Option<Rejoin>> {
+pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option<Rejoin>> {
     let views = frame.views;
     // In view order, as a registered image's correspondences are (the RANSAC's draws follow it).
-    let mut matched: Vec<(usize, &[[u32; 2]])> = (unplaced.matches.iter())
+    let mut matched: Vec<(usize, &[[u32; 2]])> = (image.matches.iter())
         .filter_map(|(other, m)| Some((*frame.index.get(other.as_str())?, m.as_slice())))
         .collect();
     matched.sort_unstable_by_key(|&(w, _)| w);
     let mut c = Vec::new();
     for (w, matches) in matched {
         for &[ku, kw] in matches {
-            let xy = unplaced.keypoints.get(ku as usize);
+            let xy = image.keypoints.get(ku as usize);
             if let (Some(xy), Some(Some(point))) = (xy, views.views[w].point_of.get(kw as usize)) {
                 let (xy, point, matched) = (*xy, *point, Some([ku, kw]));
                 c.push(Correspondence {
@@ -254,8 +250,8 @@ pub fn place_unregistered(
     if c.len() < MIN_SUPPORT {
         return Ok(None);
     }
-    let camera = (frame.model.cameras.iter()).find(|c| c.camera_id == unplaced.camera_id);
-    let intrinsics = Intrinsics::from_camera(camera.unwrap_or(&unplaced.camera));
+    let camera = (frame.model.cameras.iter()).find(|c| c.camera_id == image.camera_id);
+    let intrinsics = Intrinsics::from_camera(camera.unwrap_or(&image.camera));
     let Some((rotation, translation)) = pnp(views, &intrinsics, &c)? else {
         return Ok(None);
     };

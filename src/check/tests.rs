@@ -1306,14 +1306,14 @@ fn lost_image(mut model: SparseModel) -> (SparseModel, Evidence) {
         &lost,
         refused_matches(&model.images[0], &lost),
     );
-    let unplaced = evidence::Unplaced {
+    let image = evidence::LostImage {
         camera_id: 1,
         camera: camera(),
         keypoints: lost.points2d.iter().map(|p| p.xy).collect(),
         matches: Vec::new(),
     };
-    evidence.unplaced.insert(lost.image.name.clone(), unplaced);
-    evidence.gather_unplaced_matches();
+    evidence.lost_images.insert(lost.image.name.clone(), image);
+    evidence.gather_lost_matches();
     (model, evidence)
 }
 
@@ -1339,7 +1339,7 @@ fn an_image_the_mapper_lost_is_placed_by_its_true_pairs() {
     assert_eq!(run.evidence().rejoin, true_pairs);
     // Without the image's keypoints there is nothing to place.
     let mut unread = evidence.clone();
-    unread.unplaced.clear();
+    unread.lost_images.clear();
     assert!(run_of(&model, &unread).rejoined.is_empty());
 
     let (ghost, ghost_evidence) = lost_image(ghosted_model());

@@ -366,7 +366,7 @@ fn read_inputs(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<Inp
     if let (Some(e), Some(db)) = (&mut evidence, &db) {
         unregistered = e.unregistered(&models, DEFAULT_MIN_NUM_MATCHES);
         let lost = e.lost(&models, DEFAULT_MIN_NUM_MATCHES);
-        e.read_unplaced(db, &lost)?;
+        e.read_lost(db, &lost)?;
     }
     Ok(Inputs {
         dirs,

@@ -202,7 +202,7 @@ impl Parameters {
             let lost: BTreeSet<String> = (runs.iter())
                 .flat_map(|models| evidence.lost(models, self.min_num_matches))
                 .collect();
-            evidence.read_unplaced(db, &lost)?;
+            evidence.read_lost(db, &lost)?;
             let settings = &check::DEFAULT_SETTINGS;
             let (found, _) =
                 check::loop_evidence(&rules.model, &runs, "--model", &evidence, settings)?;
