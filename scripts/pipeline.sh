@@ -21,10 +21,11 @@
 #                   (a ghost's pairs to blame, or pairs that place a misplaced group, join
 #                   clean models or place an image no model registered), `prune --model` with
 #                   every model so far and one more mapper run,
-#                   a row `repairedK` per turn [0]; in a repair turn, the images the database
-#                   links and the mapper left out (a piece the blame cut off: COLMAP 3.8 starts
-#                   no second model from narrow pairs) are mapped on their own into
-#                   sparse_repairedK/left, counted in the mapper's seconds (README); a turn
+#                   a row `repairedK` per turn [0]; in the loop's runs, the pruned one's too,
+#                   the images the database links and the mapper left out (a piece the blame
+#                   cut off: COLMAP 3.8 starts no second model from narrow pairs) are mapped
+#                   on their own into sparse_VARIANT/left, counted in the mapper's seconds
+#                   (README); a turn
 #                   whose mapper makes no model ends the loop, the model before it stands
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
@@ -77,8 +78,8 @@ log "prune $prune_args"
 # The pruned database was just rewritten, so its reconstruction is redone.
 rm -f "$work/sparse_pruned.seconds"
 
-# A repair turn's second mapper run (scripts/map-left-out.sh): the images its database links and
-# its first run left out, mapped into sparse_VARIANT/left; its seconds are added to the turn's.
+# The loop's second mapper run (scripts/map-left-out.sh): the images its database links and
+# its first run left out, mapped into sparse_VARIANT/left; its seconds are added to the run's.
 map_left_out() {
   local variant=$1 sparse=$work/sparse_$1 first seconds
   seconds=$(timed "$work/left_$variant.log" env VGSEL="$bin" "$here/scripts/map-left-out.sh" \
@@ -102,7 +103,12 @@ map_and_eval() {
     tolerated=$outcome timed "$work/mapper_$variant.log" colmap mapper \
       --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse" \
       --Mapper.extract_colors 0 >"$sparse.seconds"
-    [[ $variant == repaired* ]] && map_left_out "$variant"
+    # The loop maps the images a run left out on their own before checking it, the pruned
+    # run's too: a piece that starts a model stays apart, only images that start none are
+    # placed by their matches (docs/check.md, "Cameras lost beside a clean model").
+    if [[ $variant == repaired* ]] || { [ "$variant" = pruned ] && [ "${REPAIR:-0}" -gt 0 ]; }; then
+      map_left_out "$variant"
+    fi
   fi
   eval_args=(--model "$sparse" --database_path "$work/$variant.db")
   [ -n "$gt" ] && eval_args+=(--ground_truth "$gt")

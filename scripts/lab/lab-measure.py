@@ -23,8 +23,9 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             verified pairs FILE lists, one `NAME1 NAME2` a line, e.g. another method's
             selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; `repair`:
             the repair loop after the `disambiguation` run of the same variant, order and mapper:
-            `check` its model, and where its report's `repair` is not empty (a ghost, a
-            misplaced group or image, pieces to join, lost images to place) `prune --model`
+            `check` its model (with COLMAP 3.8, after mapping the images it left out on
+            their own, as every turn), and where its report's `repair` is not empty (a ghost,
+            a misplaced group or image, pieces to join, lost images to place) `prune --model`
             with every model so far
             and map once more, at most REPAIR_TURNS times, else that run stands; with COLMAP
             3.8 each turn also maps the images it left out, scripts/map-left-out.sh); --order, default image_id; mapper colmap3.8
@@ -318,6 +319,17 @@ def scored_run(images, work, dbs, spec):
         return result
     if preset == "repair":
         result, models = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}"), []
+        if kind != "global":
+            # The loop's first run is that model with the images it left out mapped on their
+            # own, as every turn's (pipeline.sh): a piece that starts a model stays apart,
+            # and only images that start none are placed in it by their matches.
+            first = os.path.join(work, f"sparse_{tag}_turn0")
+            if not os.path.exists(first + ".done"):
+                shutil.rmtree(first, ignore_errors=True)
+                shutil.copytree(result["sparse"], first)
+                open(first + ".done", "w").close()
+            result = measured(images, work, db, variant, order, kind, [], None,
+                              f"{tag}_turn0", "disambiguation", [], left_out=True)
         for turn in range(1, REPAIR_TURNS + 1):
             # A turn whose mapper made no model (COLMAP 3.8 found no initial pair) ends the
             # loop, recorded as it is (pipeline.sh keeps the model before it).
@@ -345,9 +357,11 @@ def scored_run(images, work, dbs, spec):
     return result
 
 
-def measured(images, work, db, variant, order, kind, extra, listed, tag, preset, loop):
+def measured(images, work, db, variant, order, kind, extra, listed, tag, preset, loop,
+             left_out=False):
     """One run, prune (PRESET with EXTRA and LOOP's options; `full`, `truth` or LISTED pairs
-    without), mapper and eval, its files named by TAG: its record."""
+    without), mapper and eval, its files named by TAG: its record. With COLMAP 3.8, a loop's
+    run (LOOP, or LEFT_OUT for its first) also maps the images it left out on their own."""
     if preset == "full":
         pruned, r = db, None
     elif preset == "truth":
@@ -363,7 +377,7 @@ def measured(images, work, db, variant, order, kind, extra, listed, tag, preset,
         r = json.load(open(report))
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
-    if loop and kind != "global":
+    if (loop or left_out) and kind != "global":
         map_left_out(pruned, images, sparse)
     txt = os.path.join(work, "truth_txt")
     model = any(d.isdigit() for d in os.listdir(sparse)) if os.path.isdir(sparse) else False

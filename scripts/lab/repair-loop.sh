@@ -39,7 +39,9 @@ map_with() { # MAPPER DB OUT STEP: COLMAP 3.8's mapper (colmap3.8) or pycolmap's
     nice colmap mapper --database_path "$2" --image_path "$images" --output_path "$3" \
       "${init[@]}" >"$3.log" 2>&1 || grep -q "failed to create sparse model" "$3.log"
     echo '{}' >"$3.json"
-    if [ -n "$repair" ] && [ "${LEFT_OUT:-1}" = 1 ]; then
+    # Every run of the loop, the first too: a piece that starts a model stays apart, only
+    # images that start none are placed by their matches (docs/check.md).
+    if [ "$turns" -gt 0 ] && [ "${LEFT_OUT:-1}" = 1 ]; then
       VGSEL=$bin nice scripts/map-left-out.sh "$2" "$images" "$3" "${init[@]}" >/dev/null
     fi
   else
