@@ -38,7 +38,8 @@ pub struct CheckArgs {
     plots: Option<PathBuf>,
     /// Write the images that the database's usable pairs link and no model registered, one name
     /// a line, as `colmap mapper --image_list_path` reads them (empty when there are none):
-    /// with COLMAP 3.8, a repair turn maps them on their own into DIR/left (README).
+    /// with COLMAP 3.8, the repair loop maps them on their own into DIR/left after every run
+    /// (README).
     #[arg(long, value_name = "FILE", requires = "database_path")]
     unregistered: Option<PathBuf>,
     /// The repair loop's earlier mapper output folders on this database, in the order they ran

@@ -62,7 +62,8 @@ pub struct PruneArgs {
     /// A mapper's output on this database (a model folder or its output_path), for the repair
     /// loop: the pairs that glued a model `check` finds ghosted, and those a wrong model
     /// refused among the images it placed consistently, are never selected, the pairs
-    /// that link clean models `check` joins or place a misplaced image back are kept, and the
+    /// that link clean models `check` joins or place a misplaced image back are kept, so are
+    /// the pairs that place an image no model registered in a clean model (unless blamed), and the
     /// matches that held a misplaced image are dropped from the pairs kept (docs/check.md).
     /// Repeat it with every earlier turn's output, in order, so that no turn selects again what
     /// an earlier one blamed.
