@@ -258,8 +258,8 @@ pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option
     // Per other view: correspondences, and those agreeing with the pose.
     let mut per_view: BTreeMap<usize, [usize; 2]> = BTreeMap::new();
     for k in &c {
-        let agrees = (intrinsics.project(&(rotation * views.points[k.point] + translation)))
-            .is_some_and(|q| (q[0] - k.xy[0]).hypot(q[1] - k.xy[1]) <= AGREE_PX);
+        let agrees =
+            reprojection_error(views, &intrinsics, (&rotation, &translation), k) <= AGREE_PX;
         let counts = per_view.entry(k.view).or_default();
         *counts = [counts[0] + 1, counts[1] + usize::from(agrees)];
     }
@@ -289,6 +289,18 @@ pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option
 /// A world-to-camera rotation and translation.
 type Pose = (Matrix3<f64>, Vector3<f64>);
 
+/// Pixels between correspondence `k`'s keypoint and its point projected through `intrinsics` at
+/// `pose` (infinite where the point falls behind the camera or outside the image).
+fn reprojection_error(
+    views: &Views,
+    intrinsics: &Intrinsics,
+    (rotation, translation): (&Matrix3<f64>, &Vector3<f64>),
+    k: &Correspondence,
+) -> f64 {
+    (intrinsics.project(&(rotation * views.points[k.point] + translation)))
+        .map_or(f64::INFINITY, |q| (q[0] - k.xy[0]).hypot(q[1] - k.xy[1]))
+}
+
 /// [`image_placements`] for view `v`: `None` with too few correspondences or no pose.
 fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>> {
     let c = correspondences(views, v);
@@ -300,9 +312,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
         return Ok(None);
     };
     let error = |r: &Matrix3<f64>, t: &Vector3<f64>, k: &Correspondence| {
-        view.intrinsics
-            .project(&(r * views.points[k.point] + t))
-            .map_or(f64::INFINITY, |q| (q[0] - k.xy[0]).hypot(q[1] - k.xy[1]))
+        reprojection_error(views, &view.intrinsics, (r, t), k)
     };
     let far = HOLDING_FAR * view.intrinsics.width.hypot(view.intrinsics.height);
     // Per other view: correspondences, those agreeing with the model's pose and those
