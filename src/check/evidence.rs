@@ -179,10 +179,7 @@ fn not_registered<'a>(
     pairs: impl Iterator<Item = (&'a NamePair, usize)>,
     min_num_matches: usize,
 ) -> Vec<String> {
-    let registered: HashSet<&str> = (models.iter())
-        .flat_map(|m| &m.images)
-        .map(|im| im.image.name.as_str())
-        .collect();
+    let registered = registered(models);
     let linked: BTreeSet<&String> = pairs
         .filter(|(_, inliers)| *inliers >= min_num_matches)
         .flat_map(|((a, b), _)| [a, b])
@@ -190,5 +187,13 @@ fn not_registered<'a>(
     (linked.into_iter())
         .filter(|name| !registered.contains(name.as_str()))
         .cloned()
+        .collect()
+}
+
+/// The names of the images some model of `models` registered.
+pub fn registered(models: &[SparseModel]) -> HashSet<&str> {
+    (models.iter())
+        .flat_map(|m| &m.images)
+        .map(|im| im.image.name.as_str())
         .collect()
 }

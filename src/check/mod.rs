@@ -24,7 +24,7 @@ pub mod views;
 use crate::colmap::sparse::SparseModel;
 use anyhow::{Context, Result};
 use conflict::Counts;
-use evidence::Evidence;
+use evidence::{registered, Evidence};
 use rayon::prelude::*;
 use serde::Serialize;
 use settings::score;
@@ -537,10 +537,7 @@ fn rejoin(
     checks: &[ModelCheck],
     evidence: &Evidence,
 ) -> Result<Vec<resection::Rejoin>> {
-    let registered: BTreeSet<&str> = (models.iter())
-        .flat_map(|m| &m.images)
-        .map(|im| im.image.name.as_str())
-        .collect();
+    let registered = registered(models);
     let lost: Vec<_> = (evidence.lost_images.iter())
         .filter(|(name, _)| !registered.contains(name.as_str()))
         .collect();
