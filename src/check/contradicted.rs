@@ -46,10 +46,7 @@ pub fn refused_pairs(views: &Views, group: &[Option<bool>]) -> Vec<[String; 2]> 
     let mut out: Vec<[String; 2]> = judged
         .into_iter()
         .filter(|&(a, b)| tied.find(a) == tied.find(b))
-        .map(|(a, b)| {
-            let (x, y) = (&views.views[a].name, &views.views[b].name);
-            [x.min(y).clone(), x.max(y).clone()]
-        })
+        .map(|(a, b)| views.name_pair(a, b))
         .collect();
     out.sort();
     out
@@ -98,10 +95,7 @@ pub fn neighbours_apart(views: &Views, order: &[String]) -> Vec<[String; 2]> {
             _ => false,
         })
         .filter(|&&(a, b)| held(views, a, b, Some(AGREE_PX)) == Some(Held::Apart))
-        .map(|&(a, b)| {
-            let (x, y) = (&views.views[a].name, &views.views[b].name);
-            [x.min(y).clone(), x.max(y).clone()]
-        })
+        .map(|&(a, b)| views.name_pair(a, b))
         .collect();
     out.sort();
     out

@@ -16,6 +16,15 @@ use std::collections::{BTreeMap, BTreeSet, HashSet};
 /// Image names of a pair, in name order.
 pub type NamePair = (String, String);
 
+/// The names `a` and `b` in name order, as pairs are listed in reports and repair lists.
+pub fn in_name_order(a: String, b: String) -> [String; 2] {
+    if a < b {
+        [a, b]
+    } else {
+        [b, a]
+    }
+}
+
 /// The database's side of the check, read once for every model.
 #[derive(Clone, Debug, Default)]
 pub struct Evidence {

@@ -24,7 +24,7 @@ pub mod views;
 use crate::colmap::sparse::SparseModel;
 use anyhow::{Context, Result};
 use conflict::Counts;
-use evidence::{registered, Evidence};
+use evidence::{in_name_order, registered, Evidence};
 use rayon::prelude::*;
 use serde::Serialize;
 use settings::score;
@@ -630,15 +630,14 @@ impl RunCheck<'_> {
         }
         let mut links = BTreeSet::new();
         for [a, b] in images.flat_map(|m| &m.links).cloned() {
-            links.insert(if a < b { [a, b] } else { [b, a] });
+            links.insert(in_name_order(a, b));
         }
         let placed = self
             .models
             .iter()
             .flat_map(|c| c.misplaced.iter().chain(&c.ghost_placement));
         for l in self.joins.iter().chain(placed).flat_map(|j| &j.links) {
-            let (a, b) = (l.image1.clone(), l.image2.clone());
-            links.insert(if a < b { [a, b] } else { [b, a] });
+            links.insert(in_name_order(l.image1.clone(), l.image2.clone()));
         }
         let rejoin = (self.rejoined.iter())
             .flat_map(|r| r.links.iter().cloned())

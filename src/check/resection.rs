@@ -8,7 +8,7 @@
 //! matches, pruned or not, place it back. The pairs that agree with that pose are the links
 //! `prune --model` keeps; those that agree with the model's pose instead are blamed.
 
-use super::evidence::LostImage;
+use super::evidence::{in_name_order, LostImage};
 use super::join::{spread_of, MISPLACED_DISTANCE};
 use super::views::{Intrinsics, Views};
 use crate::colmap::sparse::SparseModel;
@@ -270,11 +270,7 @@ pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option
     let mut links = Vec::new();
     for (w, [n, s]) in per_view {
         if n >= PAIR_MIN_CORRESPONDENCES && 2 * s >= n {
-            let other = views.views[w].name.clone();
-            links.push(match name < other.as_str() {
-                true => [name.to_string(), other],
-                false => [other, name.to_string()],
-            });
+            links.push(in_name_order(name.to_string(), views.views[w].name.clone()));
         }
     }
     Ok(Some(Rejoin {

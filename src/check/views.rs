@@ -3,7 +3,7 @@
 //! keypoints; each 3D point with the images that observe it; with a database, the verified
 //! matches between the registered images ([`super::evidence`]).
 
-use super::evidence::Evidence;
+use super::evidence::{in_name_order, Evidence};
 use crate::colmap::model::ModelCamera;
 use crate::colmap::sparse::SparseModel;
 use anyhow::{Context, Result};
@@ -221,6 +221,12 @@ impl<'e> Views<'e> {
             cell,
             matches,
         })
+    }
+
+    /// The names of views `a` and `b`, in name order.
+    pub fn name_pair(&self, a: usize, b: usize) -> [String; 2] {
+        let name = |v: usize| self.views[v].name.clone();
+        in_name_order(name(a), name(b))
     }
 
     /// Whether view `b`'s keypoints within `radius_b` pixels of `at` are matched to keypoints
