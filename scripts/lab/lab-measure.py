@@ -323,13 +323,19 @@ def scored_run(images, work, dbs, spec):
             # The loop's first run is that model with the images it left out mapped on their
             # own, as every turn's (pipeline.sh): a piece that starts a model stays apart,
             # and only images that start none are placed in it by their matches.
-            first = os.path.join(work, f"sparse_{tag}_turn0")
-            if not os.path.exists(first + ".done"):
-                shutil.rmtree(first, ignore_errors=True)
-                shutil.copytree(result["sparse"], first)
-                open(first + ".done", "w").close()
-            result = measured(images, work, db, variant, order, kind, [], None,
-                              f"{tag}_turn0", "disambiguation", [], left_out=True)
+            # Its model, database and prune report, taken as they are (not pruned and mapped
+            # again).
+            first, preset_tag = f"{tag}_turn0", f"disambiguation_{variant}_{order}"
+            sparse = os.path.join(work, f"sparse_{first}")
+            if not os.path.exists(sparse + ".done"):
+                shutil.rmtree(sparse, ignore_errors=True)
+                shutil.copytree(result["sparse"], sparse)
+                shutil.copyfile(result["database"], os.path.join(work, f"pruned_{first}.db"))
+                shutil.copyfile(os.path.join(work, f"prune_{preset_tag}.json"),
+                                os.path.join(work, f"prune_{first}.json"))
+                open(sparse + ".done", "w").close()
+            result = measured(images, work, db, variant, order, kind, [], None, first,
+                              "disambiguation", [], left_out=True)
         for turn in range(1, REPAIR_TURNS + 1):
             # A turn whose mapper made no model (COLMAP 3.8 found no initial pair) ends the
             # loop, recorded as it is (pipeline.sh keeps the model before it).
