@@ -2,11 +2,11 @@
 # The repair loop's second run of COLMAP 3.8's mapper, after each of its runs and before their
 # check (README, "Is the model ghosted?"): the images the database links (a pair of 15 inliers
 # or more) and no model of SPARSE registered, mapped on their own into SPARSE/left, where
-# `check --model`, `eval` and `prune --model` read them as part of the same run. COLMAP 3.8 relaxes its initial pair only while it has no model at all, so a
-# piece that `prune --model` cut off and whose neighbours see their surroundings under small
-# angles starts no model of its own (docs/check.md, "Pieces that start no model"). COLMAP 4
-# needs none of this: its incremental mapper relaxes while images are left, its global mapper
-# has no initial pair.
+# `check --model`, `eval` and `prune --model` read them as part of the same run. COLMAP 3.8
+# relaxes its initial pair only while it has no model at all, so a piece that `prune --model`
+# cut off and whose neighbours see their surroundings under small angles starts no model of its
+# own (docs/check.md, "Pieces that start no model"). COLMAP 4 needs none of this: its
+# incremental mapper relaxes while images are left, its global mapper has no initial pair.
 #
 # usage: scripts/map-left-out.sh DB IMAGES SPARSE [MAPPER_OPTION ...]
 #   DB       the database the turn's mapper ran on
