@@ -27,7 +27,8 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             their own, as every turn), and where its report's `repair` is not empty (a ghost,
             a misplaced group or image, pieces to join, lost images to place) `prune --model`
             with every model so far
-            and map once more, at most REPAIR_TURNS times, else that run stands; with COLMAP
+            and map once more, at most REPAIR_TURNS times; the record is the loop's answer,
+            its last run `check` calls clean, else its last (`last`: the last run); with COLMAP
             3.8 each turn also maps the images it left out, scripts/map-left-out.sh); --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).
@@ -336,9 +337,12 @@ def scored_run(images, work, dbs, spec):
                 open(sparse + ".done", "w").close()
             result = measured(images, work, db, variant, order, kind, [], None, first,
                               "disambiguation", [], left_out=True)
-        for turn in range(1, REPAIR_TURNS + 1):
+        # The loop's answer (pipeline.sh's): its last run the check calls clean, else its
+        # last run with a model.
+        clean, made = None, result
+        for turn in range(1, REPAIR_TURNS + 2):
             # A turn whose mapper made no model (COLMAP 3.8 found no initial pair) ends the
-            # loop, recorded as it is (pipeline.sh keeps the model before it).
+            # loop.
             if not os.listdir(result["sparse"]):
                 break
             report = result["sparse"] + ".check.json"
@@ -349,13 +353,17 @@ def scored_run(images, work, dbs, spec):
             if checked.returncode not in (0, 3):
                 sys.exit(f"lab-measure: check failed on {result['sparse']}: "
                          f"{checked.stderr.decode()}")
-            # Nothing for `prune --model` to act on: the loop stops at this model.
-            if not any(json.load(open(report))["repair"].values()):
+            made = result
+            if checked.returncode == 0:
+                clean = result
+            # Nothing for `prune --model` to act on, or no turn left: the loop stops here.
+            if turn > REPAIR_TURNS or not any(json.load(open(report))["repair"].values()):
                 break
             models += ["--model", result["sparse"]]
             result = measured(images, work, db, variant, order, kind, extra, None,
                               tag if turn == 1 else f"{tag}_turn{turn}", "disambiguation", models)
-        result = dict(result, preset="repair", turns=len(models) // 2)
+        result = dict(clean or made, preset="repair", turns=len(models) // 2,
+                      last=result["sparse"])
         json.dump(result, open(path, "w"), indent=1)
         return result
     result = measured(images, work, db, variant, order, kind, extra, listed, tag, preset, [])

@@ -8,7 +8,8 @@
 # ghost's blamed pairs, or pairs that place a misplaced group, join clean models or place an
 # image no model registered) prunes again
 # with --model and maps once more. Every model is scored against the ground truth.
-# Prints one row per run and mapper; writes WORKDIR/loop.json.
+# Prints one row per run and mapper, after the loop its answer (its last run the check calls
+# clean, else its last, as pipeline.sh); writes WORKDIR/loop.json.
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
 # most [3], each passing every earlier model to `prune --model`. REPAIR_INIT_ANGLE: COLMAP 3.8's
 # initial-pair angle in the repair turns (--Mapper.init_min_tri_angle) [COLMAP's own, 16]; the
@@ -93,6 +94,8 @@ for run in $(seq 1 "$runs"); do
 done
 python3 - "$work" "$runs" "$mappers" "$num_images" <<'PY'
 import json, os, sys
+sys.path.insert(0, "scripts/lab")
+import loop_answer  # the loop's answer, pipeline.sh's rule
 work, runs, mappers, n = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), int(sys.argv[4])
 rows = []
 verdict = lambda c: next((k.replace("_", " ") for k in ("no_model", "ghosted", "misplaced", "unanchored")
@@ -114,13 +117,14 @@ for run in range(1, runs + 1):
                                   no_model=c.get("no_model", False)))
             if not steps:
                 continue
-            rows.append(dict(run=run, matching=matcher, mapper=mapper, steps=steps))
-            first, last = steps[0], steps[-1]
+            answer = loop_answer.answer(steps)
+            rows.append(dict(run=run, matching=matcher, mapper=mapper, steps=steps, answer=answer))
+            first, last = steps[0], steps[answer]
             after = (f"{last['correct']:>20}/{n} {last['models']:>6} {verdict(last):>10}"
                      if len(steps) > 1 else f"{'(not needed)':>23} {'':>6} {'':>10}")
             print(f"{run:>3} {matcher:<12} {mapper:<10} {first['correct']:>11}/{n} "
                   f"{verdict(first):>10} {len(steps) - 1:>5} {after}")
-final = [r["steps"][-1]["correct"] for r in rows]
+final = [r["steps"][r["answer"]]["correct"] for r in rows]
 print(f"after the loop: {n}/{n} correct in {sum(c == n for c in final)} of {len(final)} runs; "
       f"before it: {sum(r['steps'][0]['correct'] == n for r in rows)} of {len(rows)}")
 json.dump(rows, open(f"{work}/loop.json", "w"), indent=1)

@@ -1,0 +1,46 @@
+"""loop_answer.py on loop.json rows written here: the last clean run answers, else the last run
+with a model."""
+import json
+import os
+import tempfile
+import unittest
+
+from lab_tool import run
+
+
+def step(correct, **flags):
+    """One run of a loop, as repair-loop.sh records it."""
+    return {"correct": correct, "registered": 44, "models": 1, "ghosted": False,
+            "misplaced": False, "unanchored": False, "no_model": False, **flags}
+
+
+class LoopAnswer(unittest.TestCase):
+    def test_the_last_clean_run_answers(self):
+        loops = [
+            # A clean run's join ends in a ghost: the clean run answers.
+            [step(21, ghosted=True), step(44), step(23, ghosted=True)],
+            # Nothing clean: the last run.
+            [step(20, ghosted=True), step(30, misplaced=True)],
+            # A turn made no model: the clean run before it.
+            [step(30, ghosted=True), step(40), step(0, no_model=True)],
+            # Clean at the end: the last run.
+            [step(22, ghosted=True), step(44)],
+        ]
+        rows = [{"run": k + 1, "matching": "colmap3.8", "mapper": "colmap3.8", "steps": s}
+                for k, s in enumerate(loops)]
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "loop.json")
+            with open(path, "w") as f:
+                json.dump(rows, f)
+            out = run("loop_answer.py", path)
+        self.assertIn("run 1 colmap3.8 colmap3.8: correct by run [21, 44, 23], the answer is "
+                      "run 2 (44 against 23)", out)
+        self.assertIn("the answer is run 2 (40 against 0)", out)
+        self.assertNotIn(" run 2 colmap3.8", out)
+        self.assertNotIn(" run 4 colmap3.8", out)
+        self.assertIn("4 loops, 2 answered by an earlier run; correct cameras summed: 158 "
+                      "(the last runs: 97)", out)
+
+
+if __name__ == "__main__":
+    unittest.main()
