@@ -1,10 +1,12 @@
 //! `generate`: writes synthetic test data: a matched COLMAP database with its ground truth, a
 //! view graph for `solve`, or rendered images with ground-truth poses.
 
+use super::args::choice;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use std::path::PathBuf;
-use vgsel_colmap::eval::{render, synth};
+use vgsel_colmap::eval::render::{self, SceneKind};
+use vgsel_colmap::eval::synth;
 use vgsel_colmap::flow::{graph_file, synthetic_graph};
 
 #[derive(Subcommand)]
@@ -41,27 +43,11 @@ enum GraphArrangement {
     Loop,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum SceneArg {
-    /// One object in a room, cameras orbiting it.
-    Room,
-    /// Two identical objects in differently textured halves of a room, linked by a walk.
-    Duplicate,
-    /// Two identical objects far apart, each orbited all round, linked by a few overview views.
-    Twin,
-    /// One object that looks the same from opposite sides, orbited all round.
-    Symmetric,
-    /// A row of identical buildings walked past by cameras translating along it.
-    Street,
-    /// Two identical objects in differently textured halves of a room, each orbited all round.
-    Hall,
-}
-
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
 pub struct GenerateImagesArgs {
-    #[arg(long, value_enum, default_value = "room")]
-    scene: SceneArg,
+    #[arg(long, value_parser = choice::<SceneKind>(), default_value = "room")]
+    scene: SceneKind,
     /// Output folder (images/ and gt/ are created in it).
     #[arg(long, value_name = "DIR")]
     output: PathBuf,
@@ -102,15 +88,7 @@ pub fn run(command: &GenerateCommand) -> Result<()> {
     match command {
         GenerateCommand::Database(args) => run_database(args),
         GenerateCommand::Images(args) => {
-            let kind = match args.scene {
-                SceneArg::Room => render::SceneKind::Room,
-                SceneArg::Duplicate => render::SceneKind::Duplicate,
-                SceneArg::Twin => render::SceneKind::Twin,
-                SceneArg::Symmetric => render::SceneKind::Symmetric,
-                SceneArg::Street => render::SceneKind::Street,
-                SceneArg::Hall => render::SceneKind::Hall,
-            };
-            render::Scene::build(kind, args.num_images, args.seed)
+            render::Scene::build(args.scene, args.num_images, args.seed)
                 .and_then(|scene| scene.write(&args.output))
         }
         GenerateCommand::Graph(args) => run_graph(args),

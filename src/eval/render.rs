@@ -17,6 +17,7 @@
 use crate::colmap::ids::SIMPLE_RADIAL;
 use crate::eval::synth::scene::look_at;
 use crate::eval::synth::{write_gt_model, GroundTruth, GtCamera, GtImage};
+use crate::named::Named;
 use anyhow::{ensure, Context, Result};
 use nalgebra::{Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -69,6 +70,39 @@ pub const STREET_PERIOD: f64 = 5.0;
 
 /// Buildings in the street's row, the first with its corner at the origin.
 pub const STREET_BUILDINGS: usize = 6;
+
+impl Named for SceneKind {
+    const ALL: &'static [SceneKind] = &[
+        SceneKind::Room,
+        SceneKind::Duplicate,
+        SceneKind::Twin,
+        SceneKind::Symmetric,
+        SceneKind::Street,
+        SceneKind::Hall,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            SceneKind::Room => "room",
+            SceneKind::Duplicate => "duplicate",
+            SceneKind::Twin => "twin",
+            SceneKind::Symmetric => "symmetric",
+            SceneKind::Street => "street",
+            SceneKind::Hall => "hall",
+        }
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            SceneKind::Room => "One object in a room, cameras orbiting it",
+            SceneKind::Duplicate => "Two identical objects in differently textured halves of a room, each half-orbited, linked by a walk",
+            SceneKind::Twin => "Two identical objects far apart, each orbited all round, linked by a walk past three boxes",
+            SceneKind::Symmetric => "One object that looks the same from opposite sides, orbited all round",
+            SceneKind::Street => "A row of identical buildings walked past by cameras translating along it",
+            SceneKind::Hall => "Two identical objects in differently textured halves of a room, each orbited all round, linked by a walk",
+        }
+    }
+}
 
 /// What a rendered scene is rebuilt from (`gt/scene.json`): [`Scene::build`]'s arguments.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -679,6 +713,16 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The name `generate images --scene` takes is the one `gt/scene.json` records.
+    #[test]
+    fn each_design_is_named_as_its_record_names_it() {
+        for &kind in SceneKind::ALL {
+            let json = serde_json::to_string(&kind).unwrap();
+            assert_eq!(json, format!("\"{}\"", kind.name()));
+            assert_eq!(SceneKind::from_name(kind.name()), Some(kind));
+        }
+    }
 
     /// The world point seen at the centre of pixel (i, j) projects back onto that centre
     /// through the written ground truth: renderer and COLMAP model share one convention.
