@@ -217,7 +217,7 @@ pub fn place_group(
 }
 
 /// `model`'s images named in `names`, with the points they observe.
-fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
+pub(super) fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
     let images: Vec<SparseImage> = model
         .images
         .iter()

@@ -169,6 +169,47 @@ fn a_ghosted_model_is_found_with_its_two_groups() {
     assert!(!worst.joining_pairs.is_empty());
 }
 
+/// Three copies glued into one model: three differently textured walls at one place, each
+/// seen by every third camera, one object in front of them all.
+fn three_copies() -> SparseModel {
+    let mut rng = Lcg(5);
+    let walls: Vec<_> = (0..3).map(|w| wall(&mut rng, 2000, 10_000 * w)).collect();
+    let object: Vec<_> = (0..300)
+        .map(|k| (40_000 + k, [rng.next() - 0.5, rng.next() - 0.5, 4.5]))
+        .collect();
+    let images = (0..18u32)
+        .map(|k| {
+            let mut seen = object.clone();
+            seen.extend(&walls[k as usize % 3]);
+            image_at(k + 1, [-1.5 + 0.2 * k as f64, 0.0], &seen, 0.6, &mut rng)
+        })
+        .collect();
+    model(images, &[walls.concat(), object].concat())
+}
+
+/// A ghost of three copies: the worst split is one copy against the other two, and the split
+/// inside that group is the other two apart; a ghost of two copies has none.
+#[test]
+fn a_ghost_of_three_copies_names_the_split_inside_a_group() {
+    let check = check_model(&three_copies(), None, &DEFAULT_SETTINGS).unwrap();
+    assert!(check.ghosted, "score {}", check.score);
+    let copy = |name: &String| (name[..4].parse::<u32>().unwrap() - 1) % 3;
+    let copies = |g: &Vec<String>| g.iter().map(copy).collect::<BTreeSet<_>>();
+    let worst = check.worst.unwrap();
+    let sizes = worst.groups.clone().map(|g| copies(&g).len());
+    assert!(sizes == [1, 2] || sizes == [2, 1], "{:?}", worst.groups);
+    let [inner] = &check.inner[..] else {
+        panic!("one split inside: {:?}", check.inner)
+    };
+    let [a, b] = inner.groups.clone().map(|g| copies(&g));
+    assert_eq!((a.len(), b.len()), (1, 1), "{:?}", inner.groups);
+    assert_ne!(a, b);
+    assert!(check_model(&ghosted_model(), None, &DEFAULT_SETTINGS)
+        .unwrap()
+        .inner
+        .is_empty());
+}
+
 /// What `ghost_of_images` asks of a ghost's misplaced images: a ghost of groups stays one
 /// without one of its images, or with a whole group left out; a split that conflicts for one
 /// image's sake is clean without it.

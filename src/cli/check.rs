@@ -161,6 +161,15 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
                 examples(w.joining_pairs.iter().map(|p| (&p.image1, &p.image2)))
             );
         }
+        for inner in &c.inner {
+            line += &format!(
+                "; within a group, groups of {} and {} images (score {:.2}; {} joining pairs)",
+                inner.groups[0].len(),
+                inner.groups[1].len(),
+                inner.score,
+                inner.joining_pairs.len()
+            );
+        }
         if let Some(m) = &c.ghost_placement {
             line += &placement_text(m);
         }
