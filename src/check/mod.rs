@@ -146,6 +146,25 @@ impl ModelCheck<'_> {
             || !self.neighbours_apart.is_empty()
     }
 
+    /// Each view's group: 0 and 1 the worst split's, then one more per split inside
+    /// ([`ModelCheck::inner`]), whose second group's images take the next number.
+    pub fn groups(&self) -> Vec<usize> {
+        let mut group: Vec<usize> = self.side.iter().map(|&b| usize::from(b)).collect();
+        let names = self
+            .views
+            .iter()
+            .flat_map(|v| v.views.iter().map(|w| &w.name));
+        let names: Vec<&String> = names.collect();
+        for (k, split) in self.inner.iter().enumerate() {
+            for (v, name) in names.iter().enumerate() {
+                if split.groups[1].contains(name) {
+                    group[v] = 2 + k;
+                }
+            }
+        }
+        group
+    }
+
     /// The database's matches place a group or an image of it elsewhere than the model does.
     pub fn places_elsewhere(&self) -> bool {
         self.misplaced.is_some() || !self.misplaced_images.is_empty()

@@ -10,7 +10,15 @@ use std::path::Path;
 /// Points drawn at most (every k-th, so the SVG stays small).
 const MAX_POINTS: usize = 4000;
 
-const GROUP_COLOURS: [RGBColor; 2] = [RGBColor(31, 119, 180), RGBColor(230, 85, 13)];
+/// One colour per group (a ghost of more than two copies has more), in turn.
+const GROUP_COLOURS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(230, 85, 13),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(214, 39, 40),
+    RGBColor(140, 86, 75),
+];
 
 /// The plane "from above": the images' mean up direction (COLMAP's image y points down) is
 /// the normal; world x (or z) projected onto the plane is the first axis.
@@ -30,8 +38,9 @@ fn top_axes(views: &Views) -> [Vector3<f64>; 2] {
     [first, up.cross(&first)]
 }
 
-/// Writes the top view of `views` split by `side` to `path` (SVG), titled `title`.
-pub fn top_view(views: &Views, side: &[bool], title: &str, path: &Path) -> Result<()> {
+/// Writes the top view of `views`, each image coloured by its group in `group` (0, 1, ...:
+/// [`super::ModelCheck::groups`]), to `path` (SVG), titled `title`.
+pub fn top_view(views: &Views, group: &[usize], title: &str, path: &Path) -> Result<()> {
     let axes = top_axes(views);
     let flat = |x: &Vector3<f64>| (axes[0].dot(x), axes[1].dot(x));
     let centres: Vec<(f64, f64)> = views.views.iter().map(|v| flat(&v.centre)).collect();
@@ -75,11 +84,9 @@ pub fn top_view(views: &Views, side: &[bool], title: &str, path: &Path) -> Resul
         )
         .map_err(|e| err(&e))?;
     let arrow = 0.04 * (x1 - x0).max(y1 - y0);
-    for (k, group) in ["group 1", "group 2"].iter().enumerate() {
-        let colour = GROUP_COLOURS[k];
-        let members: Vec<usize> = (0..side.len())
-            .filter(|&v| usize::from(side[v]) == k)
-            .collect();
+    for k in 0..=group.iter().copied().max().unwrap_or(0) {
+        let colour = GROUP_COLOURS[k % GROUP_COLOURS.len()];
+        let members: Vec<usize> = (0..group.len()).filter(|&v| group[v] == k).collect();
         let ends = members.iter().map(|&v| {
             let dir = views.views[v].rotation.transpose() * Vector3::z();
             let (dx, dy) = (axes[0].dot(&dir), axes[1].dot(&dir));
@@ -98,7 +105,7 @@ pub fn top_view(views: &Views, side: &[bool], title: &str, path: &Path) -> Resul
                     .map(|&v| Circle::new(centres[v], 5, colour.filled())),
             )
             .map_err(|e| err(&e))?
-            .label(format!("{group} ({} images)", members.len()))
+            .label(format!("group {} ({} images)", k + 1, members.len()))
             .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
     }
     chart

@@ -195,7 +195,7 @@ fn a_ghost_of_three_copies_names_the_split_inside_a_group() {
     assert!(check.ghosted, "score {}", check.score);
     let copy = |name: &String| (name[..4].parse::<u32>().unwrap() - 1) % 3;
     let copies = |g: &Vec<String>| g.iter().map(copy).collect::<BTreeSet<_>>();
-    let worst = check.worst.unwrap();
+    let worst = check.worst.as_ref().unwrap();
     let sizes = worst.groups.clone().map(|g| copies(&g).len());
     assert!(sizes == [1, 2] || sizes == [2, 1], "{:?}", worst.groups);
     let [inner] = &check.inner[..] else {
@@ -204,6 +204,17 @@ fn a_ghost_of_three_copies_names_the_split_inside_a_group() {
     let [a, b] = inner.groups.clone().map(|g| copies(&g));
     assert_eq!((a.len(), b.len()), (1, 1), "{:?}", inner.groups);
     assert_ne!(a, b);
+    // The top view's groups are the three copies.
+    let names: Vec<String> = (1..=18).map(|k| format!("{k:04}.png")).collect();
+    let by_group: BTreeSet<(usize, u32)> = (check.groups().into_iter())
+        .zip(&names)
+        .map(|(g, name)| (g, copy(name)))
+        .collect();
+    assert_eq!(by_group.len(), 3, "{by_group:?}");
+    assert_eq!(
+        by_group.iter().map(|p| p.0).collect::<BTreeSet<_>>().len(),
+        3
+    );
     assert!(check_model(&ghosted_model(), None, &DEFAULT_SETTINGS)
         .unwrap()
         .inner

@@ -122,7 +122,7 @@ fn plot(plots: &Path, k: usize, dir: &Path, result: &ModelCheck) -> Result<()> {
         result.score
     );
     let path = plots.join(format!("top_view_{k}.svg"));
-    check::plot::top_view(views, &result.side, &title, &path)
+    check::plot::top_view(views, &result.groups(), &title, &path)
 }
 
 /// The line a model gets: its verdict, score and groups; a clean model whose worst split had
