@@ -128,7 +128,7 @@ pub struct ModelCheck<'e> {
     #[serde(skip)]
     pub weakest_link: Option<(Vec<bool>, Split)>,
     /// A ghost of more than two copies: the ghosted splits inside the worst split's groups,
-    /// each group checked as a model of its own, and so on inside theirs ([`inner_splits`]).
+    /// each group checked as a model of its own, and so on inside theirs.
     /// Told, not blamed: the repair blames the worst split only (docs/check.md).
     pub inner: Vec<Split>,
     /// The views (for plots).
