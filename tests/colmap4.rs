@@ -340,10 +340,16 @@ fn python_recipe_prunes_between_matching_and_mapping() {
     .args([f.images.as_os_str(), work.as_os_str()])
     .args(["--vgsel", env!("CARGO_BIN_EXE_vgsel-colmap")])
     .args(["--max_features", "1024", "--", "--preset", "disambiguation"]);
-    let summary: Value = serde_json::from_slice(&run_ok(&mut cmd).stdout).unwrap();
+    let out = run_ok(&mut cmd);
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
     let n = |k: &str| summary[k].as_u64().unwrap();
     assert!(n("pairs_selected") < n("pairs_total"), "{summary}");
-    assert_eq!(n("registered"), 20, "{summary}");
+    // The global mapper made no model once in some twenty runs (session 27, 55 pairs kept of
+    // 153; 16 reruns of the recipe registered 20): its log's end says why, should it again.
+    let log = String::from_utf8_lossy(&out.stderr);
+    let tail: Vec<&str> = log.lines().rev().take(30).collect();
+    let tail: Vec<&str> = tail.into_iter().rev().collect();
+    assert_eq!(n("registered"), 20, "{summary}\n{}", tail.join("\n"));
     let db = work.join("database.db");
     let inspect = ok(&["inspect", "--json", "--database_path", s(&db)]);
     let inspect: Value = serde_json::from_slice(&inspect.stdout).unwrap();
