@@ -25,10 +25,9 @@
 #                   the images the database links and the mapper left out (a piece the blame
 #                   cut off: COLMAP 3.8 starts no second model from narrow pairs) are mapped
 #                   on their own into sparse_VARIANT/left, counted in the mapper's seconds
-#                   (README); a turn
-#                   whose mapper makes no model ends the loop, the model before it stands;
-#                   the loop's answer (WORKDIR/answer, summary.json's loop_answer) is its last
-#                   run the check calls clean, else its last run
+#                   (README); a turn whose mapper makes no model ends the loop, the model
+#                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
+#                   loop_answer) is its last run the check calls clean, else its last run
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/.." && pwd)

@@ -68,6 +68,7 @@ import shutil
 import subprocess
 import sys
 
+import loop_answer
 from colmap_files import ROOT, VGSEL, natural, only_pairs, read_images, view_graph
 
 WINDOW = 3
@@ -337,9 +338,8 @@ def scored_run(images, work, dbs, spec):
                 open(sparse + ".done", "w").close()
             result = measured(images, work, db, variant, order, kind, [], None, first,
                               "disambiguation", [], left_out=True)
-        # The loop's answer (pipeline.sh's): its last run the check calls clean, else its
-        # last run with a model.
-        clean, made = None, result
+        # Each checked run with its report, for the loop's answer (loop_answer.answer).
+        runs, reports = [], []
         for turn in range(1, REPAIR_TURNS + 2):
             # A turn whose mapper made no model (COLMAP 3.8 found no initial pair) ends the
             # loop.
@@ -353,17 +353,16 @@ def scored_run(images, work, dbs, spec):
             if checked.returncode not in (0, 3):
                 sys.exit(f"lab-measure: check failed on {result['sparse']}: "
                          f"{checked.stderr.decode()}")
-            made = result
-            if checked.returncode == 0:
-                clean = result
+            runs.append(result)
+            reports.append(json.load(open(report)))
             # Nothing for `prune --model` to act on, or no turn left: the loop stops here.
-            if turn > REPAIR_TURNS or not any(json.load(open(report))["repair"].values()):
+            if turn > REPAIR_TURNS or not any(reports[-1]["repair"].values()):
                 break
             models += ["--model", result["sparse"]]
             result = measured(images, work, db, variant, order, kind, extra, None,
                               tag if turn == 1 else f"{tag}_turn{turn}", "disambiguation", models)
-        result = dict(clean or made, preset="repair", turns=len(models) // 2,
-                      last=result["sparse"])
+        answer = runs[loop_answer.answer(reports)] if runs else result
+        result = dict(answer, preset="repair", turns=len(models) // 2, last=result["sparse"])
         json.dump(result, open(path, "w"), indent=1)
         return result
     result = measured(images, work, db, variant, order, kind, extra, listed, tag, preset, [])

@@ -4,8 +4,9 @@ else its last run with a model. A clean run's turn (pieces joined, lost images p
 a ghost that the loop has no turn left to repair; the clean run before it is the better answer.
 
 As a module: `answer(steps)` on the steps of a scripts/lab/repair-loop.sh loop (its loop.json
-rows). As a tool: every loop of the given loop.json files, their last run against their answer
-(docs/check.md, "The loop's answer").
+rows) or on a loop's `check --report`s (lab-measure.py), whose flags are the same. As a tool:
+every loop of the given loop.json files, their last run against their answer (docs/check.md,
+"The loop's answer").
 
 usage: scripts/lab/loop_answer.py LOOP_JSON...
 Prints the loops whose answer is not their last run, then the totals."""
@@ -14,7 +15,8 @@ import sys
 
 
 def clean(step):
-    """The check called every model of the run clean (exit 0)."""
+    """The check called every model of the run clean (exit 0: none of these flags, which
+    `check --report` and repair-loop.sh's steps both carry)."""
     flags = ("ghosted", "misplaced", "unanchored", "folded", "no_model")
     return not any(step.get(k) for k in flags)
 
