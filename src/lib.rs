@@ -16,7 +16,7 @@ pub mod costs;
 pub mod eval;
 pub use vgsel_flow as flow;
 pub mod geometry;
-pub mod named;
+pub use vgsel_flow::named;
 pub mod outputs;
 pub mod priors;
 pub mod scene;

@@ -93,7 +93,6 @@ const PRODUCT: &[&str] = &[
     "src/selection",
     "src/outputs",
     "src/flow",
-    "src/named.rs",
     "src/check",
 ];
 
@@ -111,7 +110,7 @@ fn the_library_does_not_depend_on_the_argument_parser() {
     forbid(
         &[PRODUCT, &["src/eval", "src/lib.rs"]].concat(),
         &["clap"],
-        "the library names its choices (crate::named::Named); only src/cli parses the command line",
+        "the libraries name their choices (vgsel_flow::named::Named); only src/cli parses the command line",
     );
 }
 

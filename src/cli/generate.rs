@@ -3,11 +3,12 @@
 
 use super::args::choice;
 use anyhow::{bail, Context, Result};
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 use std::path::PathBuf;
 use vgsel_colmap::eval::render::{self, SceneKind};
 use vgsel_colmap::eval::synth;
-use vgsel_colmap::flow::{graph_file, synthetic_graph};
+use vgsel_colmap::flow::graph_file;
+use vgsel_colmap::flow::synthetic_graph::{self, Arrangement};
 
 #[derive(Subcommand)]
 pub enum GenerateCommand {
@@ -26,21 +27,17 @@ pub struct GenerateGraphArgs {
     /// The graph file to write.
     #[arg(long, value_name = "FILE")]
     output: PathBuf,
+    /// Images (vertices), at least 2.
     #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
     images: u64,
+    /// Pairs (edges), at most images x (images - 1) / 2.
     #[arg(long)]
     pairs: u64,
-    /// Images along a line (a facade) or a closed loop (around a building).
-    #[arg(long, value_enum, default_value = "loop")]
-    arrangement: GraphArrangement,
+    #[arg(long, value_parser = choice::<Arrangement>(), default_value = "loop")]
+    arrangement: Arrangement,
+    /// The random generator's seed: the same seed gives the same graph.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum GraphArrangement {
-    Linear,
-    Loop,
 }
 
 #[derive(Args)]
@@ -51,8 +48,10 @@ pub struct GenerateImagesArgs {
     /// Output folder (images/ and gt/ are created in it).
     #[arg(long, value_name = "DIR")]
     output: PathBuf,
+    /// Images to render.
     #[arg(long, default_value_t = 20)]
     num_images: usize,
+    /// The random generator's seed (textures, placements): the same seed gives the same images.
     #[arg(long, default_value_t = 1)]
     seed: u64,
 }
@@ -130,11 +129,7 @@ fn run_graph(args: &GenerateGraphArgs) -> Result<()> {
             n * (n - 1) / 2
         );
     }
-    let arrangement = match args.arrangement {
-        GraphArrangement::Linear => synthetic_graph::Arrangement::Linear,
-        GraphArrangement::Loop => synthetic_graph::Arrangement::Loop,
-    };
-    let problem = synthetic_graph::generate(n as usize, e as usize, arrangement, args.seed);
+    let problem = synthetic_graph::generate(n as usize, e as usize, args.arrangement, args.seed);
     std::fs::write(&args.output, graph_file::write(&problem))
         .with_context(|| format!("cannot write graph {}", args.output.display()))
 }

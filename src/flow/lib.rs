@@ -6,6 +6,7 @@
 
 pub mod connectivity;
 pub mod graph_file;
+pub mod named;
 pub mod network;
 pub mod search;
 pub mod solver;

@@ -3,6 +3,7 @@
 //! it, costs uniform in [-1, 0], labels shuffled as in unordered photo collections. Used by the
 //! solver benchmarks; deterministic from a seed.
 
+use crate::named::Named;
 use crate::network::{PairArc, SelectionProblem};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
@@ -17,6 +18,24 @@ pub enum Arrangement {
     Linear,
     /// Around a loop, neighbours wrap around (around a building).
     Loop,
+}
+
+impl Named for Arrangement {
+    const ALL: &'static [Self] = &[Arrangement::Linear, Arrangement::Loop];
+
+    fn name(self) -> &'static str {
+        match self {
+            Arrangement::Linear => "linear",
+            Arrangement::Loop => "loop",
+        }
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            Arrangement::Linear => "images along a line, open at both ends (a facade, a street)",
+            Arrangement::Loop => "images around a closed loop (around a building)",
+        }
+    }
 }
 
 /// `images` vertices and exactly `pairs` edges. The neighbourhood spread is the mean degree, so

@@ -1,6 +1,7 @@
-//! Values a user picks by name from a fixed list (`--preset`, `--order`, `--format`): their
-//! names and one-line help live with the types, in the library, so that the command line
-//! (`src/cli`) offers them without the library depending on an argument parser.
+//! Values a user picks by name from a fixed list (`--preset`, `--order`, `--format`,
+//! `--arrangement`): their names and one-line help live with the types, in the libraries, so
+//! that the command line (`src/cli`) offers them without a library depending on an argument
+//! parser. Here, in the lowest crate, so that every crate's types can have names.
 
 /// A closed set of values, each with the name a user types and a line of help.
 pub trait Named: Copy + Send + Sync + 'static {
