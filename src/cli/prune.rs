@@ -125,7 +125,8 @@ pub struct PruneArgs {
     /// Pairs whose fitness (−cost, in [0, 1]) is below this are never selected: a floor that
     /// stops flow paths running from one copy of a duplicated structure to another over
     /// low-ranked pairs. With a searched flow it is lowered until the image criterion's share
-    /// of images keep a pair above it.
+    /// of images keep a pair above it that the selection may use (not one forbidden, or blamed
+    /// by --model).
     #[arg(long, value_parser = fraction, help_heading = EXPERT)]
     min_pair_fitness: Option<f64>,
 }

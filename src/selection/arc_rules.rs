@@ -415,11 +415,19 @@ pub fn remove_below_floor(rules: &mut [ArcRule], pair_costs: &[f64], floor: f64)
 
 /// The cost model's `min_pair_fitness` (`floor`), lowered where needed so that the image
 /// criterion's share of images keep a pair above it, and at least half as many pairs as the
-/// pair criterion asks for reach it. On scenes where the priors score every pair low (real
-/// photos where few triangles close within the loop tolerance) a fixed floor left the flow too
-/// few pairs for `colmap mapper` to start a model (docs/priors.md). With a fixed flow it is
-/// applied as given.
-pub fn fitness_floor(floor: f64, rule: &FlowRule, graph: &ViewGraph, pair_costs: &[f64]) -> f64 {
+/// pair criterion asks for reach it, counting only the pairs the flow may use (`rules`: not
+/// those removed, forbidden or blamed by `--model`). On scenes where the priors score every
+/// pair low (real photos where few triangles close within the loop tolerance) a fixed floor
+/// left the flow too few pairs for `colmap mapper` to start a model (docs/priors.md); so did a
+/// floor that counted the pairs a ghosted model blamed, where they were most of those above it
+/// (the twin design, docs/check.md). With a fixed flow it is applied as given.
+pub fn fitness_floor(
+    floor: f64,
+    rule: &FlowRule,
+    graph: &ViewGraph,
+    rules: &[ArcRule],
+    pair_costs: &[f64],
+) -> f64 {
     let FlowRule::Criteria(criteria) = rule else {
         return floor;
     };
@@ -435,15 +443,21 @@ pub fn fitness_floor(floor: f64, rule: &FlowRule, graph: &ViewGraph, pair_costs:
             .1
     };
     // Each image's best pair fitness: the wanted-th best image sets the highest usable floor.
+    // The usable edges' fitness (−cost).
+    let usable = || {
+        (graph.edges.iter().zip(rules).zip(pair_costs))
+            .filter(|((_, rule), _)| **rule != ArcRule::Removed)
+            .map(|((e, _), cost)| (e, -cost))
+    };
     let mut best = vec![0.0f64; n];
-    for (e, cost) in graph.edges.iter().zip(pair_costs) {
+    for (e, fitness) in usable() {
         for v in [e.i as usize, e.j as usize] {
-            best[v] = best[v].max(-cost);
+            best[v] = best[v].max(fitness);
         }
     }
     let images = (criteria.min_image_fraction * n as f64).ceil() as usize;
     let pairs = (criteria.min_pairs_per_image * n as f64 / 2.0).ceil() as usize;
-    let fitness = pair_costs.iter().map(|c| -c).collect();
+    let fitness = usable().map(|(_, fitness)| fitness).collect();
     floor.min(kth(best, images)).min(kth(fitness, pairs))
 }
 
@@ -651,7 +665,8 @@ mod tests {
         };
         // The disambiguation preset's floor.
         let preset = 0.6;
-        let floor = |rule: FlowRule| fitness_floor(preset, &rule, &graph, &costs);
+        let free = [ArcRule::Free; 4];
+        let floor = |rule: FlowRule| fitness_floor(preset, &rule, &graph, &free, &costs);
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor
         // (0.6) already, and half of 0.4 pairs per image x 5 images is one pair.
         assert_eq!(floor(rule(0.6, 0.4, None)), preset);
@@ -662,5 +677,16 @@ mod tests {
         assert_eq!(floor(rule(0.6, 1.2, None)), 0.2);
         // A fixed flow takes the floor as given.
         assert_eq!(floor(rule(1.0, 1.2, Some(3))), preset);
+        // A pair the rules removed (forbidden, or blamed by a model) keeps no image: without
+        // 1-2 (0.9), image 1 has no pair, and of the rest three images reach 0.6 no more: 2 and
+        // 3 (0.8) only. The third best image is 4 (0.2).
+        let blamed = [
+            ArcRule::Removed,
+            ArcRule::Free,
+            ArcRule::Free,
+            ArcRule::Free,
+        ];
+        let floor = fitness_floor(preset, &rule(0.6, 0.4, None), &graph, &blamed, &costs);
+        assert_eq!(floor, 0.2);
     }
 }

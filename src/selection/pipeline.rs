@@ -280,7 +280,7 @@ fn apply_arc_rules(
     let neighbours_kept = arc_rules::keep_neighbours(&mut edges, graph, order, window);
     let floor = parameters.cost_model.min_pair_fitness;
     let rule = parameters.flow.rule();
-    let floor = arc_rules::fitness_floor(floor, &rule, graph, &costs.pair_costs);
+    let floor = arc_rules::fitness_floor(floor, &rule, graph, &edges, &costs.pair_costs);
     let below_fitness_floor = arc_rules::remove_below_floor(&mut edges, &costs.pair_costs, floor);
     let network = problem(graph, costs, order)
         .restrict(&order.by_rank(&overrides.forbidden_vertices), &edges);
