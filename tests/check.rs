@@ -205,7 +205,8 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
 /// (docs/check.md). The README's repair from that model, `prune --preset disambiguation --model`,
 /// reaches the twin's bound (exactly its true pairs: one orbit, or both in two models) with no
 /// ghost. It blames most pairs above the preset's fitness floor; while the floor counted them,
-/// the selection left COLMAP 3.8 no model (two seeds of three). About three minutes on 2 cores.
+/// the selection left COLMAP 3.8 no model (two seeds of three). About four to five minutes on 2
+/// cores.
 #[test]
 fn the_repair_from_the_twins_full_model_leaves_no_ghost() {
     let (dir, work) = pipeline(SceneKind::Twin, 36, 0);
