@@ -210,7 +210,6 @@ fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
 #[test]
 fn the_repair_from_the_twins_full_model_leaves_no_ghost() {
     let (dir, work) = pipeline(SceneKind::Twin, 36, 0);
-    let s = |p: &Path| p.to_str().unwrap().to_string();
     let (full, full_model, db) = variant_run(&work, "full");
     assert!(
         truth_ghosted(&full),
@@ -219,31 +218,8 @@ fn the_repair_from_the_twins_full_model_leaves_no_ghost() {
     let left = work.join("left_full.txt");
     let out = check_with(&full_model, &db, &[], &left);
     assert_eq!(out.status.code(), Some(3), "{out:?}");
-    let (repaired, model) = (
-        work.join("twin_repaired.db"),
-        work.join("sparse_twin_repaired"),
-    );
-    let args = [
-        "prune",
-        "-q",
-        "--preset",
-        "disambiguation",
-        "--model",
-        &s(&full_model),
-    ];
-    let out = vgsel(
-        &[
-            &args[..],
-            &["--database_path", &s(&db), "--output", &s(&repaired)],
-        ]
-        .concat(),
-    );
-    assert!(out.status.success(), "{out:?}");
-    let mapper = colmap_mapper(&repaired, &dir.path().join("images"), &model, None);
-    assert!(mapper.status.success(), "{mapper:?}");
-    let gt = dir.path().join("gt");
-    let eval = vgsel(&["eval", "--model", &s(&model), "--ground_truth", &s(&gt)]);
-    let eval: Value = serde_json::from_slice(&eval.stdout).unwrap();
+    let (images, gt) = (dir.path().join("images"), dir.path().join("gt"));
+    let (eval, _, _) = repair_full_model(&work, &images, &gt, "disambiguation", "twin_repaired");
     eprintln!(
         "repaired from the full model: {} of {} correct",
         eval["correct"], eval["registered"]
@@ -495,24 +471,8 @@ fn placements_agree_with_the_check(model: &Path, db: &Path, gt: &Path, report: &
 /// `check`; where it is not, the repair must change nothing a mapper would notice.
 fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let (repaired, model) = (work.join("repaired.db"), work.join("sparse_repaired"));
-    let full_model = s(&work.join("sparse_full"));
-    let args = ["prune", "-q", "--preset", "general", "--model", &full_model];
-    let database = s(&work.join("full.db"));
+    let (eval, model, repaired) = repair_full_model(work, images, gt, "general", "repaired");
     let first_report = s(&work.join("prune_repaired.json"));
-    let out = vgsel(
-        &[
-            &args[..],
-            &["--database_path", &database, "--output", &s(&repaired)],
-            &["--report", &first_report],
-        ]
-        .concat(),
-    );
-    assert!(out.status.success(), "{out:?}");
-    let mapper = colmap_mapper(&repaired, images, &model, None);
-    assert!(mapper.status.success(), "{mapper:?}");
-    let eval = vgsel(&["eval", "--model", &s(&model), "--ground_truth", &s(gt)]);
-    let eval: Value = serde_json::from_slice(&eval.stdout).unwrap();
     let full: Value =
         serde_json::from_str(&std::fs::read_to_string(work.join("eval_full.json")).unwrap())
             .unwrap();
@@ -538,6 +498,45 @@ fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
         );
         assert_eq!(check.status.code(), Some(0), "{check:?}");
     }
+}
+
+/// `prune --preset PRESET --model WORK/sparse_full` on the pipeline's full database into
+/// `WORK/NAME.db` (its report `WORK/prune_NAME.json`), `colmap mapper` on that into
+/// `WORK/sparse_NAME`, and the model's `eval` against `gt`: the eval, the model folder and the
+/// database.
+fn repair_full_model(
+    work: &Path,
+    images: &Path,
+    gt: &Path,
+    preset: &str,
+    name: &str,
+) -> (Value, PathBuf, PathBuf) {
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let repaired = work.join(format!("{name}.db"));
+    let model = work.join(format!("sparse_{name}"));
+    let out = vgsel(&[
+        "prune",
+        "-q",
+        "--preset",
+        preset,
+        "--model",
+        &s(&work.join("sparse_full")),
+        "--database_path",
+        &s(&work.join("full.db")),
+        "--output",
+        &s(&repaired),
+        "--report",
+        &s(&work.join(format!("prune_{name}.json"))),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let mapper = colmap_mapper(&repaired, images, &model, None);
+    assert!(mapper.status.success(), "{mapper:?}");
+    let eval = vgsel(&["eval", "--model", &s(&model), "--ground_truth", &s(gt)]);
+    (
+        serde_json::from_slice(&eval.stdout).unwrap(),
+        model,
+        repaired,
+    )
 }
 
 /// A second turn of the loop (`--model` given twice: the full model and the repaired one) blames

@@ -442,13 +442,13 @@ pub fn fitness_floor(
             .select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a))
             .1
     };
-    // Each image's best pair fitness: the wanted-th best image sets the highest usable floor.
-    // The usable edges' fitness (−cost).
+    // The edges the flow may use, with their fitness (−cost).
     let usable = || {
         (graph.edges.iter().zip(rules).zip(pair_costs))
             .filter(|((_, rule), _)| **rule != ArcRule::Removed)
             .map(|((e, _), cost)| (e, -cost))
     };
+    // Each image's best pair fitness: the wanted-th best image sets the highest usable floor.
     let mut best = vec![0.0f64; n];
     for (e, fitness) in usable() {
         for v in [e.i as usize, e.j as usize] {
