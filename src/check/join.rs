@@ -21,7 +21,10 @@
 //! have refuted that stronger placement already: a model of it that was ghosted between the two
 //! models' images ([`Glued`]). The check saw that scene's ghost, so it can see its ghosts, and
 //! the strongest clean placement joins (streets whose repair left two correct models, the
-//! ghost's placement no longer the strongest once each copy is a model of its own).
+//! ghost's placement no longer the strongest once each copy is a model of its own), unless it
+//! puts them where that ghost had them: the refuted placement again, now under the threshold
+//! because each copy's model holds less unique structure than the ghost did
+//! ([`Glued::repeated_by`]).
 
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
@@ -130,27 +133,79 @@ impl From<&Similarity> for Placement {
     }
 }
 
-/// The two groups of images an earlier run's ghosted model put onto each other (its worst
-/// split): its placement of one group in the other's frame conflicted. Two models of a later
-/// run that lie on its two sides were placed so once already, and refuted.
-pub type Glued = [Vec<String>; 2];
-
-/// The side of `glued` (0 or 1) that holds more than half of `model`'s images, if one does.
-fn side(model: &SparseModel, glued: &Glued) -> Option<usize> {
-    let on = |g: &Vec<String>| {
-        let n = model.images.iter().filter(|im| g.contains(&im.image.name));
-        2 * n.count() > model.images.len()
-    };
-    (0..2).find(|&k| on(&glued[k]))
+/// An earlier run's ghosted model, as a later run's joins need it: the two groups of images it
+/// put onto each other (its worst split), whose placement of one in the other's frame
+/// conflicted, and where it put their cameras. Two models of a later run that lie on its two
+/// sides were placed so once already, and refuted: a placement of theirs that puts them where
+/// the ghost had them is that refuted placement again (the twin's two orbits, each a clean
+/// model after the repair, proposed onto each other as the full database's ghost had them, at
+/// 0.47 where the ghost scored 0.78; docs/check.md).
+#[derive(Clone, Debug)]
+pub struct Glued {
+    /// The two groups, image names.
+    pub groups: [Vec<String>; 2],
+    /// The ghost's cameras of both groups, by image name.
+    cameras: BTreeMap<String, ModelImage>,
 }
 
-/// How many of the earlier runs' ghosts put `a` and `b` onto each other: each lies on its own
-/// side of the ghost's split.
-fn refuted_earlier(a: &SparseModel, b: &SparseModel, earlier: &[Glued]) -> usize {
-    earlier
+impl Glued {
+    /// The ghost `model`'s split into `groups`.
+    pub fn new(model: &SparseModel, groups: [Vec<String>; 2]) -> Glued {
+        let in_groups = |im: &&SparseImage| groups.iter().any(|g| g.contains(&im.image.name));
+        let cameras = (model.images.iter().filter(in_groups))
+            .map(|im| (im.image.name.clone(), im.image.clone()))
+            .collect();
+        Glued { groups, cameras }
+    }
+
+    /// The side (0 or 1) that holds more than half of `model`'s images, if one does.
+    fn side(&self, model: &SparseModel) -> Option<usize> {
+        let on = |g: &Vec<String>| {
+            let n = model.images.iter().filter(|im| g.contains(&im.image.name));
+            2 * n.count() > model.images.len()
+        };
+        (0..2).find(|&k| on(&self.groups[k]))
+    }
+
+    /// Whether this ghost put `a` and `b` onto each other: each lies on its own side.
+    fn between(&self, a: &SparseModel, b: &SparseModel) -> bool {
+        matches!((self.side(a), self.side(b)), (Some(x), Some(y)) if x != y)
+    }
+
+    /// Whether `placement` (of `b` in `a`'s frame) puts `b`'s cameras where the ghost had them
+    /// beside `a`'s: within [`MISPLACED_DISTANCE`] of their spread (median), once `a`'s cameras
+    /// are carried onto the ghost's. False where the cameras they share fix no frame.
+    pub fn repeated_by(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> bool {
+        let shared = |m: &SparseModel| -> (Vec<ModelImage>, Vec<ModelImage>) {
+            let on = m.images.iter().filter_map(|im| {
+                let ghost = self.cameras.get(&im.image.name)?;
+                Some((im.image.clone(), ghost.clone()))
+            });
+            on.unzip()
+        };
+        let ((a_here, a_ghost), (b_here, b_ghost)) = (shared(a), shared(b));
+        let to_ghost = Similarity::fit(&camera_points(&a_here), &camera_points(&a_ghost));
+        let Some(to_ghost) = to_ghost.filter(|_| !b_here.is_empty()) else {
+            return false;
+        };
+        let off = b_here.iter().zip(&b_ghost).map(|(here, ghost)| {
+            (to_ghost.apply(&placement.apply(&here.centre())) - ghost.centre()).norm()
+        });
+        let ghost: Vec<Vector3<f64>> = self.cameras.values().map(ModelImage::centre).collect();
+        median(off) <= MISPLACED_DISTANCE * spread_of(&ghost)
+    }
+}
+
+/// Cameras as points a similarity carries: each centre, and a point ahead of it along its view
+/// at the centres' spread, so that cameras in a line (a street walked along) fix a rotation too.
+fn camera_points(cameras: &[ModelImage]) -> Vec<Vector3<f64>> {
+    let centres: Vec<Vector3<f64>> = cameras.iter().map(ModelImage::centre).collect();
+    let reach = spread_of(&centres);
+    let ahead = cameras
         .iter()
-        .filter(|g| matches!((side(a, g), side(b, g)), (Some(x), Some(y)) if x != y))
-        .count()
+        .zip(&centres)
+        .map(|(im, c)| c + reach * (im.rotation.inverse() * Vector3::z()));
+    centres.iter().copied().chain(ahead).collect()
 }
 
 /// One correspondence: the second model's point, the first's, and the database pair it is from.
@@ -171,8 +226,10 @@ pub fn join_models(
         for b in a + 1..models.len() {
             if usable(&models[a]) && usable(&models[b]) {
                 let pair = [models[a].0, models[b].0];
-                let refuted = refuted_earlier(pair[0], pair[1], earlier);
-                joins.extend(join_two([a, b], pair, evidence, settings, refuted)?);
+                let ghosts: Vec<&Glued> = (earlier.iter())
+                    .filter(|g| g.between(pair[0], pair[1]))
+                    .collect();
+                joins.extend(join_two([a, b], pair, evidence, settings, 0, &ghosts)?);
             }
         }
     }
@@ -205,7 +262,7 @@ pub fn place_group(
     }
     let [a, b] = [&groups[0], &groups[1]].map(|g| subset(model, g));
     let refuted = usize::from(ghosted);
-    let Some(join) = join_two([k, k], [&a, &b], evidence, settings, refuted)? else {
+    let Some(join) = join_two([k, k], [&a, &b], evidence, settings, refuted, &[])? else {
         return Ok(None);
     };
     let placement = Similarity::from(&join.placement);
@@ -242,14 +299,17 @@ pub(super) fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
 
 /// The join of models `[a, b]` (their indices `models`): the first placement of `b` in `a`'s
 /// frame that does not conflict, if a stronger one did; `refuted` counts placements refuted
-/// before any is tried (a ghost's own, or earlier runs' ghosts').
+/// before any is tried (a ghost's own), and each of the earlier runs' `ghosts` between the two
+/// refuted one more, and refutes its own placement again.
 fn join_two(
     models: [usize; 2],
     [a, b]: [&SparseModel; 2],
     evidence: &Evidence,
     settings: &CheckSettings,
-    mut refuted: usize,
+    refuted: usize,
+    ghosts: &[&Glued],
 ) -> anyhow::Result<Option<Join>> {
+    let mut refuted = refuted + ghosts.len();
     let (pairs, correspondences) = correspondences(a, b, evidence);
     let spread = spread(a);
     let tolerance = INLIER_DISTANCE * spread;
@@ -269,7 +329,10 @@ fn join_two(
         } else {
             links.iter().map(|l| l.agreeing).sum()
         };
-        if linked >= MIN_SUPPORT {
+        if linked >= MIN_SUPPORT && ghosts.iter().any(|g| g.repeated_by(a, b, &placement)) {
+            // An earlier ghost's placement again: refuted then, whatever it scores now.
+            refuted += 1;
+        } else if linked >= MIN_SUPPORT {
             let (merged, from_b) = put_together(a, b, &placement);
             let counts =
                 conflict::count_model(&merged, Some(evidence), &settings.conflict, |name| {

@@ -635,15 +635,14 @@ fn rejoin(
 impl RunCheck<'_> {
     /// The groups each ghost of this run put onto each other, for the joins of a later run
     /// ([`join::Glued`]): ghosts of two groups, not of misplaced images.
-    pub fn glued(&self) -> Vec<join::Glued> {
-        let ghosts = self
-            .models
-            .iter()
-            .filter(|c| c.ghosted && !c.ghost_of_images);
+    /// `models` are the run's, in the order checked.
+    pub fn glued(&self, models: &[SparseModel]) -> Vec<join::Glued> {
+        let ghosts =
+            (self.models.iter().zip(models)).filter(|(c, _)| c.ghosted && !c.ghost_of_images);
         ghosts
-            .flat_map(|c| &c.worst)
-            .filter(|w| !w.alone())
-            .map(|w| w.groups.clone())
+            .filter_map(|(c, model)| Some((c.worst.as_ref()?, model)))
+            .filter(|(w, _)| !w.alone())
+            .map(|(w, model)| join::Glued::new(model, w.groups.clone()))
             .collect()
     }
 
@@ -829,7 +828,7 @@ pub fn loop_evidence(
         let run = check_run(models, Some(evidence), settings, &earlier)
             .with_context(|| format!("checking {option} {}", dir.display()))?;
         found.push(run.evidence());
-        earlier.extend(run.glued());
+        earlier.extend(run.glued(models));
     }
     Ok((found, earlier))
 }

@@ -770,9 +770,9 @@ fn two_models_are_not_joined_without_a_refuted_ghost() {
 }
 
 /// The same two models after a repair turn whose ghost had put them onto each other (an
-/// earlier run's model, ghosted between images 1-6 and 7-12): that placement was refuted
-/// already, so their one placement without conflict joins them. A ghost between other groups
-/// (each model on both of its sides) refutes nothing of theirs.
+/// earlier run's model, ghosted between images 1-6 and 7-12, the second group elsewhere): that
+/// placement was refuted already, so their one placement without conflict joins them. A ghost
+/// between other groups (each model on both of its sides) refutes nothing of theirs.
 #[test]
 fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     let (a, b) = two_models(
@@ -783,7 +783,11 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     );
     let evidence = matches_between(&a, &b, 100_000);
     let names = |m: &SparseModel| m.images.iter().map(|im| im.image.name.clone()).collect();
-    let glued: join::Glued = [names(&a), names(&b)];
+    let ghost = SparseModel {
+        images: [a.images.clone(), b.images.clone()].concat(),
+        ..SparseModel::default()
+    };
+    let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
     let pair = [(&a, false), (&b, false)];
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[glued]).unwrap();
     assert_eq!(joins.len(), 1, "{joins:?}");
@@ -799,7 +803,25 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
         [odd(&a, 0), odd(&b, 0)].concat(),
         [odd(&a, 1), odd(&b, 1)].concat(),
     ];
+    let across = join::Glued::new(&ghost, across);
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[across]).unwrap();
+    assert!(joins.is_empty(), "{joins:?}");
+}
+
+/// The same two models, where the earlier ghost had put them just as their matches place them
+/// now (the twin's orbits, proposed onto each other again as the full database's ghost had
+/// them): that placement conflicted then, whatever it scores now, and nothing else places them.
+/// The ghost's cameras are in a frame of their own: only their arrangement counts.
+#[test]
+fn two_models_are_not_joined_where_an_earlier_ghost_had_them() {
+    let model = correct_model();
+    let (a, b) = two_models(&model, |im| im.image.image_id > 6, 100_000, &elsewhere());
+    let evidence = matches_between(&a, &b, 100_000);
+    let names = |m: &SparseModel| m.images.iter().map(|im| im.image.name.clone()).collect();
+    let (_, ghost) = two_models(&model, |_| true, 0, &elsewhere());
+    let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
+    let pair = [(&a, false), (&b, false)];
+    let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[glued]).unwrap();
     assert!(joins.is_empty(), "{joins:?}");
 }
 
