@@ -26,8 +26,11 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             `check` its model (with COLMAP 3.8, after mapping the images it left out on
             their own, as every turn), and where its report's `repair` is not empty (a ghost,
             a misplaced group or image, pieces to join, lost images to place) `prune --model`
-            with every model so far
-            and map once more, at most REPAIR_TURNS times; the record is the loop's answer,
+            with every model so far and map once more, at most REPAIR_TURNS times, as
+            scripts/pipeline.sh's loop: the `full` run's model is the first of those models
+            where `check` calls it ghosted, and then the first turn runs whatever the first
+            run's check says; a turn that selects what the last run mapped ends the loop;
+            the record is the loop's answer,
             its last run `check` calls clean, else its last (`last`: the last run); with COLMAP
             3.8 each turn also maps the images it left out, scripts/map-left-out.sh); --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
@@ -65,6 +68,7 @@ import math
 import os
 import re
 import shutil
+import sqlite3
 import subprocess
 import sys
 
@@ -338,36 +342,72 @@ def scored_run(images, work, dbs, spec):
                 open(sparse + ".done", "w").close()
             result = measured(images, work, db, variant, order, kind, [], None, first,
                               "disambiguation", [], left_out=True)
+        # The full database's model, where the check calls a model of it ghosted, is the first
+        # evidence of every turn, and the first turn runs whatever the first run's check
+        # says (as scripts/pipeline.sh; docs/check.md, "The full model in the loop").
+        full = scored_run(images, work, dbs, f"full:{variant}:{order}:{kind}")
+        full_ghost = any(m["ghosted"] for m in checked(full, [])["models"])
+        if full_ghost:
+            models = ["--model", full["sparse"]]
         # Each checked run with its report, for the loop's answer (loop_answer.answer).
-        runs, reports = [], []
+        runs, reports, turns = [], [], 0
         for turn in range(1, REPAIR_TURNS + 2):
             # A turn whose mapper made no model (COLMAP 3.8 found no initial pair) ends the
             # loop.
             if not os.listdir(result["sparse"]):
                 break
-            report = result["sparse"] + ".check.json"
-            earlier = ["--earlier_model" if a == "--model" else a for a in models]
-            checked = subprocess.run([VGSEL, "check", "--model", result["sparse"],
-                                      "--database_path", result["database"], *earlier,
-                                      "--report", report], capture_output=True)
-            if checked.returncode not in (0, 3):
-                sys.exit(f"lab-measure: check failed on {result['sparse']}: "
-                         f"{checked.stderr.decode()}")
             runs.append(result)
-            reports.append(json.load(open(report)))
+            reports.append(checked(result, models))
             # Nothing for `prune --model` to act on, or no turn left: the loop stops here.
-            if turn > REPAIR_TURNS or not any(reports[-1]["repair"].values()):
+            acts = any(reports[-1]["repair"].values()) or (turn == 1 and full_ghost)
+            if turn > REPAIR_TURNS or not acts:
                 break
             models += ["--model", result["sparse"]]
-            result = measured(images, work, db, variant, order, kind, extra, None,
-                              tag if turn == 1 else f"{tag}_turn{turn}", "disambiguation", models)
+            turn_tag = tag if turn == 1 else f"{tag}_turn{turn}"
+            # A turn that selects what the last run mapped would only map it again.
+            pruned, _ = pruned_database(db, work, order, turn_tag, "disambiguation", extra, models)
+            if same_selection(result["database"], pruned):
+                break
+            result = measured(images, work, db, variant, order, kind, extra, None, turn_tag,
+                              "disambiguation", models)
+            turns += 1
         answer = runs[loop_answer.answer(reports)] if runs else result
-        result = dict(answer, preset="repair", turns=len(models) // 2, last=result["sparse"])
+        result = dict(answer, preset="repair", turns=turns, last=result["sparse"])
         json.dump(result, open(path, "w"), indent=1)
         return result
     result = measured(images, work, db, variant, order, kind, extra, listed, tag, preset, [])
     json.dump(result, open(path, "w"), indent=1)
     return result
+
+
+def checked(result, models):
+    """The check's report on a run's model (its database's evidence), after the loop's MODELS
+    (`--model DIR` pairs, passed as its earlier runs)."""
+    report = result["sparse"] + ".check.json"
+    earlier = ["--earlier_model" if a == "--model" else a for a in models]
+    done = subprocess.run([VGSEL, "check", "--model", result["sparse"], "--database_path",
+                           result["database"], *earlier, "--report", report], capture_output=True)
+    if done.returncode not in (0, 3):
+        sys.exit(f"lab-measure: check failed on {result['sparse']}: {done.stderr.decode()}")
+    return json.load(open(report))
+
+
+def pruned_database(db, work, order, tag, preset, extra, loop):
+    """DB pruned by PRESET (with EXTRA and LOOP's options) into WORK/pruned_TAG.db, done once:
+    that database and the prune's report."""
+    pruned = os.path.join(work, f"pruned_{tag}.db")
+    report = os.path.join(work, f"prune_{tag}.json")
+    if not os.path.exists(report):
+        run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
+             "--preset", preset, "--order", order, "--report", report, *extra, *loop])
+    return pruned, json.load(open(report))
+
+
+def same_selection(a, b):
+    """Whether databases A and B leave the same pairs valid with the same inliers."""
+    query = "SELECT pair_id, data FROM two_view_geometries WHERE rows > 0 ORDER BY pair_id"
+    valid = lambda path: sqlite3.connect(path).execute(query).fetchall()
+    return valid(a) == valid(b)
 
 
 def measured(images, work, db, variant, order, kind, extra, listed, tag, preset, loop,
@@ -382,12 +422,7 @@ def measured(images, work, db, variant, order, kind, extra, listed, tag, preset,
     elif listed:
         pruned, r = listed_pairs(db, work, variant, listed, tag), None
     else:
-        pruned = os.path.join(work, f"pruned_{tag}.db")
-        report = os.path.join(work, f"prune_{tag}.json")
-        if not os.path.exists(report):
-            run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
-                 "--preset", preset, "--order", order, "--report", report, *extra, *loop])
-        r = json.load(open(report))
+        pruned, r = pruned_database(db, work, order, tag, preset, extra, loop)
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
     if (loop or left_out) and kind != "global":

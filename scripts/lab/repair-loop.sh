@@ -7,7 +7,8 @@
 # model, and where check gives `prune --model` something to act on (its report's `repair`: a
 # ghost's blamed pairs, or pairs that place a misplaced group, join clean models or place an
 # image no model registered) prunes again
-# with --model and maps once more. Every model is scored against the ground truth.
+# with --model and maps once more. Every model is scored against the ground truth. It does not
+# map the full database, so, unlike scripts/pipeline.sh's loop, it has no full model's evidence.
 # Prints one row per run and mapper, after the loop its answer (its last run the check calls
 # clean, else its last, as pipeline.sh); writes WORKDIR/loop.json.
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
