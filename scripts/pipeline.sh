@@ -21,10 +21,11 @@
 #                   (a ghost's pairs to blame, or pairs that place a misplaced group, join
 #                   clean models or place an image no model registered), `prune --model` with
 #                   every model so far and one more mapper run, a row `repairedK` per turn
-#                   [0]; the full database's model is checked too: where it is ghosted, it is
-#                   the first of those models and the first turn runs whatever the pruned
-#                   model's check says; a turn whose prune selects what the last run mapped
-#                   ends the loop; in the loop's runs, the pruned one's too,
+#                   [0]; the full database's model is checked too: where it is ghosted and
+#                   the pruned selection kept what glued it (scripts/full-model-evidence.py),
+#                   it is the first of those models and the first turn runs whatever the
+#                   pruned model's check says; a turn whose prune selects what the last run
+#                   mapped ends the loop; in the loop's runs, the pruned one's too,
 #                   the images the database links and the mapper left out (a piece the blame
 #                   cut off: COLMAP 3.8 starts no second model from narrow pairs) are mapped
 #                   on their own into sparse_VARIANT/left, counted in the mapper's seconds
@@ -135,17 +136,18 @@ map_and_eval full
 map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer"
 last=pruned models=() earlier=() answer= full_ghost=
-# The full database's model is evidence too where the check calls it ghosted: its ghost can
-# be one the pruned selection hides from the check (the twin: docs/check.md, "The full model
-# in the loop"), so its blame joins every turn's and the loop takes its first turn.
+# The full database's model is evidence too where the check calls it ghosted and the pruned
+# selection kept what glued it: the pruned model can be the same ghost, hidden from the check
+# (the twin: docs/check.md, "The full model in the loop", scripts/full-model-evidence.py), so
+# its blame joins every turn's and the loop takes its first turn.
 if [ "${REPAIR:-0}" -gt 0 ]; then
   status=0
   "$bin" check --model "$work/sparse_full" --database_path "$work/full.db" \
     --report "$work/check_full.json" >"$work/check_full.txt" || status=$?
   cat "$work/check_full.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
-  if python3 -c 'import json, sys; sys.exit(not any(m["ghosted"] for m in json.load(open(sys.argv[1]))["models"]))' \
-    "$work/check_full.json"; then
+  if share=$("$here/scripts/full-model-evidence.py" "$work/check_full.json" "$work/pruned.db"); then
+    log "the full model's ghost blames $share of the pruned selection: its evidence comes first"
     full_ghost=1 models=(--model "$work/sparse_full") earlier=(--earlier_model "$work/sparse_full")
   fi
 fi

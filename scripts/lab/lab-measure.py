@@ -28,8 +28,9 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             a misplaced group or image, pieces to join, lost images to place) `prune --model`
             with every model so far and map once more, at most REPAIR_TURNS times, as
             scripts/pipeline.sh's loop: the `full` run's model is the first of those models
-            where `check` calls it ghosted, and then the first turn runs whatever the first
-            run's check says; a turn that selects what the last run mapped ends the loop;
+            where `check` calls it ghosted and the first run kept what glued it
+            (scripts/full-model-evidence.py), and then the first turn runs whatever the
+            first run's check says; a turn that selects what the last run mapped ends the loop;
             the record is the loop's answer,
             its last run `check` calls clean, else its last (`last`: the last run); with COLMAP
             3.8 each turn also maps the images it left out, scripts/map-left-out.sh); --order, default image_id; mapper colmap3.8
@@ -342,11 +343,15 @@ def scored_run(images, work, dbs, spec):
                 open(sparse + ".done", "w").close()
             result = measured(images, work, db, variant, order, kind, [], None, first,
                               "disambiguation", [], left_out=True)
-        # The full database's model, where the check calls a model of it ghosted, is the first
-        # evidence of every turn, and the first turn runs whatever the first run's check
-        # says (as scripts/pipeline.sh; docs/check.md, "The full model in the loop").
+        # The full database's model, where the check calls a model of it ghosted and the
+        # first run's selection kept what glued it, is the first evidence of every turn, and
+        # the first turn runs whatever the first run's check says (as scripts/pipeline.sh;
+        # docs/check.md, "The full model in the loop").
         full = scored_run(images, work, dbs, f"full:{variant}:{order}:{kind}")
-        full_ghost = any(m["ghosted"] for m in checked(full, [])["models"])
+        checked(full, [])
+        full_ghost = subprocess.run([os.path.join(ROOT, "scripts", "full-model-evidence.py"),
+                                     full["sparse"] + ".check.json", result["database"]],
+                                    capture_output=True).returncode == 0
         if full_ghost:
             models = ["--model", full["sparse"]]
         # Each checked run with its report, for the loop's answer (loop_answer.answer).

@@ -45,7 +45,8 @@ pub struct CheckArgs {
     /// The repair loop's earlier mapper output folders on this database, in the order they ran
     /// (repeatable, as `prune --model` takes them): where a model of theirs was ghosted between
     /// two clean models of this run, it placed one in the other's frame and that was refuted, so
-    /// their strongest placement without conflict joins them.
+    /// their strongest placement without conflict joins them, unless it puts them where that
+    /// ghost had them.
     #[arg(long, value_name = "DIR", requires = "database_path")]
     earlier_model: Vec<PathBuf>,
     /// The images' names sort in capture order, one sequence (a walk, an orbit, a video), each
