@@ -3,9 +3,9 @@
 model in the loop"): where the check calls a model of it ghosted and its blame covers at least
 a third of the pairs the pruned selection kept. The selection then kept what glued that ghost,
 and its own model can be the same ghost with too little unique structure left for the check to
-see (the twin: 52-54% of the kept pairs blamed, on six seeds). Where the selection left the
-ghost's pairs out (streets, halls, the demo: 3-16%), the blame is mostly the true links across
-its split, and a turn on it only costs cameras (a 44-image street's image 0034 lost).
+see (the twin: 47-54% of the kept pairs blamed, on six seeds). Where the selection left most
+of the ghost's pairs out (streets, halls, the demo: 3-32%), the blame is mostly the true links
+across its split, and a turn on it only costs cameras (a 44-image street's image 0034 lost).
 
 usage: scripts/full-model-evidence.py CHECK_JSON PRUNED_DB
   CHECK_JSON  `vgsel-colmap check --report` of the full database's model
