@@ -135,7 +135,7 @@ map_and_eval() {
 map_and_eval full
 map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer"
-last=pruned models=() earlier=() answer= full_ghost=
+last=pruned models=() earlier=() answer= full_evidence=
 # The full database's model is evidence too where the check calls it ghosted and the pruned
 # selection kept what glued it: the pruned model can be the same ghost, hidden from the check
 # (the twin: docs/check.md, "The full model in the loop", scripts/full-model-evidence.py), so
@@ -148,7 +148,7 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   if share=$("$here/scripts/full-model-evidence.py" "$work/check_full.json" "$work/pruned.db"); then
     log "the full model's ghost blames $share of the pruned selection: its evidence comes first"
-    full_ghost=1 models=(--model "$work/sparse_full") earlier=(--earlier_model "$work/sparse_full")
+    full_evidence=1 models=(--model "$work/sparse_full") earlier=(--earlier_model "$work/sparse_full")
   fi
 fi
 # Every model is checked, the last turn's too, after the models before it (a clean model's
@@ -163,7 +163,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   [ "$status" = 0 ] && answer=$last
-  { [ "$turn" = 1 ] && [ -n "$full_ghost" ]; } ||
+  { [ "$turn" = 1 ] && [ -n "$full_evidence" ]; } ||
     python3 -c 'import json, sys; sys.exit(not any(json.load(open(sys.argv[1]))["repair"].values()))' \
       "$work/check_$last.json" || break
   [ "$turn" -le "$REPAIR" ] || break

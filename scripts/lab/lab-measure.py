@@ -349,10 +349,10 @@ def scored_run(images, work, dbs, spec):
         # docs/check.md, "The full model in the loop").
         full = scored_run(images, work, dbs, f"full:{variant}:{order}:{kind}")
         checked(full, [])
-        full_ghost = subprocess.run([os.path.join(ROOT, "scripts", "full-model-evidence.py"),
+        full_evidence = subprocess.run([os.path.join(ROOT, "scripts", "full-model-evidence.py"),
                                      full["sparse"] + ".check.json", result["database"]],
                                     capture_output=True).returncode == 0
-        if full_ghost:
+        if full_evidence:
             models = ["--model", full["sparse"]]
         # Each checked run with its report, for the loop's answer (loop_answer.answer).
         runs, reports, turns = [], [], 0
@@ -364,7 +364,7 @@ def scored_run(images, work, dbs, spec):
             runs.append(result)
             reports.append(checked(result, models))
             # Nothing for `prune --model` to act on, or no turn left: the loop stops here.
-            acts = any(reports[-1]["repair"].values()) or (turn == 1 and full_ghost)
+            acts = any(reports[-1]["repair"].values()) or (turn == 1 and full_evidence)
             if turn > REPAIR_TURNS or not acts:
                 break
             models += ["--model", result["sparse"]]
