@@ -148,7 +148,8 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   if share=$("$here/scripts/full-model-evidence.py" "$work/check_full.json" "$work/pruned.db"); then
     log "the full model's ghost blames $share of the pruned selection: its evidence comes first"
-    full_evidence=1 models=(--model "$work/sparse_full") earlier=(--earlier_model "$work/sparse_full")
+    full_evidence=1 models=(--model "$work/sparse_full")
+    earlier=(--earlier_model "$work/sparse_full")
   fi
 fi
 # Every model is checked, the last turn's too, after the models before it (a clean model's

@@ -349,9 +349,9 @@ def scored_run(images, work, dbs, spec):
         # docs/check.md, "The full model in the loop").
         full = scored_run(images, work, dbs, f"full:{variant}:{order}:{kind}")
         checked(full, [])
-        full_evidence = subprocess.run([os.path.join(ROOT, "scripts", "full-model-evidence.py"),
-                                     full["sparse"] + ".check.json", result["database"]],
-                                    capture_output=True).returncode == 0
+        decide = os.path.join(ROOT, "scripts", "full-model-evidence.py")
+        full_evidence = subprocess.run([decide, full["sparse"] + ".check.json",
+                                        result["database"]], capture_output=True).returncode == 0
         if full_evidence:
             models = ["--model", full["sparse"]]
         # Each checked run with its report, for the loop's answer (loop_answer.answer).
