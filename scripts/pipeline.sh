@@ -22,7 +22,7 @@
 #                   clean models or place an image no model registered), `prune --model` with
 #                   every model so far and one more mapper run, a row `repairedK` per turn
 #                   [0]; the full database's model is checked too: where it is ghosted and
-#                   the pruned selection kept what glued it (scripts/full-model-evidence.py),
+#                   the pruned selection kept what glued it (scripts/repair_loop.py),
 #                   it is the first of those models and the first turn runs whatever the
 #                   pruned model's check says; a turn whose prune selects what the last run
 #                   mapped ends the loop; in the loop's runs, the pruned one's too,
@@ -95,18 +95,6 @@ map_left_out() {
   echo "$first + $seconds" | bc >"$sparse.seconds"
 }
 
-# Whether databases $1 and $2 leave the same pairs valid with the same inliers: a turn that
-# selects what the last run mapped would only map it again (the images the check places by
-# pairs an earlier run blamed: the twin's second orbit).
-same_selection() {
-  python3 - "$1" "$2" <<'EOF'
-import sqlite3, sys
-valid = lambda path: sqlite3.connect(path).execute(
-    "SELECT pair_id, data FROM two_view_geometries WHERE rows > 0 ORDER BY pair_id").fetchall()
-sys.exit(valid(sys.argv[1]) != valid(sys.argv[2]))
-EOF
-}
-
 # The mapper on one database of WORKDIR (full, pruned or repaired) and the eval of its model.
 map_and_eval() {
   local variant=$1 sparse=$work/sparse_$1
@@ -138,7 +126,7 @@ rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer
 last=pruned models=() earlier=() answer= full_evidence=
 # The full database's model is evidence too where the check calls it ghosted and the pruned
 # selection kept what glued it: the pruned model can be the same ghost, hidden from the check
-# (the twin: docs/check.md, "The full model in the loop", scripts/full-model-evidence.py), so
+# (the twin: docs/check.md, "The full model in the loop", scripts/repair_loop.py), so
 # its blame joins every turn's and the loop takes its first turn.
 if [ "${REPAIR:-0}" -gt 0 ]; then
   status=0
@@ -146,7 +134,7 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
     --report "$work/check_full.json" >"$work/check_full.txt" || status=$?
   cat "$work/check_full.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
-  if share=$("$here/scripts/full-model-evidence.py" "$work/check_full.json" "$work/pruned.db"); then
+  if share=$("$here/scripts/repair_loop.py" full-model "$work/check_full.json" "$work/pruned.db"); then
     log "the full model's ghost blames $share of the pruned selection: its evidence comes first"
     full_evidence=1 models=(--model "$work/sparse_full")
     earlier=(--earlier_model "$work/sparse_full")
@@ -174,7 +162,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
     --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args
-  if same_selection "$work/$last.db" "$work/repaired$turn.db"; then
+  if "$here/scripts/repair_loop.py" same-selection "$work/$last.db" "$work/repaired$turn.db"; then
     log "turn $turn selects what the $last run mapped: the loop stops"
     break
   fi

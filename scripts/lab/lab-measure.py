@@ -29,7 +29,7 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             with every model so far and map once more, at most REPAIR_TURNS times, as
             scripts/pipeline.sh's loop: the `full` run's model is the first of those models
             where `check` calls it ghosted and the first run kept what glued it
-            (scripts/full-model-evidence.py), and then the first turn runs whatever the
+            (scripts/repair_loop.py), and then the first turn runs whatever the
             first run's check says; a turn that selects what the last run mapped ends the loop;
             the record is the loop's answer,
             its last run `check` calls clean, else its last (`last`: the last run); with COLMAP
@@ -69,12 +69,14 @@ import math
 import os
 import re
 import shutil
-import sqlite3
 import subprocess
 import sys
 
 import loop_answer
 from colmap_files import ROOT, VGSEL, natural, only_pairs, read_images, view_graph
+
+sys.path.append(os.path.join(ROOT, "scripts"))
+import repair_loop  # noqa: E402 (scripts/, found through ROOT)
 
 WINDOW = 3
 # The repair loop's turns at most (`repair` runs), as scripts/lab/repair-loop.sh's default.
@@ -349,9 +351,8 @@ def scored_run(images, work, dbs, spec):
         # docs/check.md, "The full model in the loop").
         full = scored_run(images, work, dbs, f"full:{variant}:{order}:{kind}")
         checked(full, [])
-        decide = os.path.join(ROOT, "scripts", "full-model-evidence.py")
-        full_evidence = subprocess.run([decide, full["sparse"] + ".check.json",
-                                        result["database"]], capture_output=True).returncode == 0
+        full_evidence, _ = repair_loop.full_model(full["sparse"] + ".check.json",
+                                                  result["database"])
         if full_evidence:
             models = ["--model", full["sparse"]]
         # Each checked run with its report, for the loop's answer (loop_answer.answer).
@@ -371,7 +372,7 @@ def scored_run(images, work, dbs, spec):
             turn_tag = tag if turn == 1 else f"{tag}_turn{turn}"
             # A turn that selects what the last run mapped would only map it again.
             pruned, _ = pruned_database(db, work, order, turn_tag, "disambiguation", extra, models)
-            if same_selection(result["database"], pruned):
+            if repair_loop.same_selection(result["database"], pruned):
                 break
             result = measured(images, work, db, variant, order, kind, extra, None, turn_tag,
                               "disambiguation", models)
@@ -406,13 +407,6 @@ def pruned_database(db, work, order, tag, preset, extra, loop):
         run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
              "--preset", preset, "--order", order, "--report", report, *extra, *loop])
     return pruned, json.load(open(report))
-
-
-def same_selection(a, b):
-    """Whether databases A and B leave the same pairs valid with the same inliers."""
-    query = "SELECT pair_id, data FROM two_view_geometries WHERE rows > 0 ORDER BY pair_id"
-    valid = lambda path: sqlite3.connect(path).execute(query).fetchall()
-    return valid(a) == valid(b)
 
 
 def measured(images, work, db, variant, order, kind, extra, listed, tag, preset, loop,

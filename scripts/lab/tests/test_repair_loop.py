@@ -1,0 +1,83 @@
+"""scripts/repair_loop.py: the share of the pruned selection's pairs the full model's ghost blames
+decides whether the repair loop takes that model's evidence (full-model); a turn that leaves the
+same pairs and inliers valid as the last run's database is not mapped (same-selection)."""
+import json
+import os
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import unittest
+
+SCRIPT = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(
+    __file__)))), "repair_loop.py")
+MAX_IMAGES = 2147483647
+
+
+def pruned_db(path, kept, dropped, inliers=b"\0" * 160):
+    """A database of five images a.png..e.png (ids 1..5) whose pairs `kept` have 20 inliers
+    (`inliers`, their data) and whose pairs `dropped` have none (rows 0, as a prune leaves
+    them)."""
+    db = sqlite3.connect(path)
+    db.execute("CREATE TABLE images (image_id INTEGER, name TEXT)")
+    db.execute("CREATE TABLE two_view_geometries (pair_id INTEGER, rows INTEGER, data BLOB)")
+    ids = {name: k + 1 for k, name in enumerate(["a.png", "b.png", "c.png", "d.png", "e.png"])}
+    db.executemany("INSERT INTO images VALUES (?, ?)", [(i, n) for n, i in ids.items()])
+    for pairs, rows, data in ((kept, 20, inliers), (dropped, 0, None)):
+        for a, b in pairs:
+            i, j = sorted((ids[a], ids[b]))
+            db.execute("INSERT INTO two_view_geometries VALUES (?, ?, ?)",
+                       (i * MAX_IMAGES + j, rows, data))
+    db.commit()
+
+
+class FullModelEvidence(unittest.TestCase):
+    def decide(self, ghosted, blamed):
+        """Exit status and output for a full model (ghosted or not) blaming `blamed`, against a
+        selection that kept four pairs and dropped one."""
+        kept = [("a.png", "b.png"), ("b.png", "c.png"), ("c.png", "d.png"), ("d.png", "e.png")]
+        with tempfile.TemporaryDirectory() as tmp:
+            db, report = os.path.join(tmp, "pruned.db"), os.path.join(tmp, "check.json")
+            pruned_db(db, kept, [("a.png", "e.png")])
+            json.dump({"models": [{"ghosted": False}, {"ghosted": ghosted}],
+                       "repair": {"blamed": blamed}}, open(report, "w"))
+            out = subprocess.run([sys.executable, SCRIPT, "full-model", report, db],
+                                 capture_output=True, text=True)
+        return out.returncode, out.stdout.strip()
+
+    def test_a_ghost_blaming_half_the_kept_pairs_is_taken(self):
+        # Names in either order; the dropped pair a-e counts for nothing.
+        blamed = [["c.png", "b.png"], ["d.png", "e.png"], ["a.png", "e.png"]]
+        self.assertEqual(self.decide(True, blamed), (0, "0.50"))
+
+    def test_a_ghost_blaming_a_quarter_of_the_kept_pairs_is_not(self):
+        blamed = [["a.png", "b.png"], ["a.png", "e.png"], ["b.png", "e.png"]]
+        self.assertEqual(self.decide(True, blamed), (1, "0.25"))
+
+    def test_a_model_without_a_ghost_is_not_taken_whatever_it_blames(self):
+        blamed = [["a.png", "b.png"], ["b.png", "c.png"], ["c.png", "d.png"]]
+        self.assertEqual(self.decide(False, blamed), (1, "0 (no ghost)"))
+
+
+class SameSelection(unittest.TestCase):
+    def same(self, second_kept, second_inliers=b"\0" * 160):
+        """Exit status of same-selection between a database keeping a-b and b-c and one keeping
+        `second_kept` with `second_inliers`."""
+        with tempfile.TemporaryDirectory() as tmp:
+            first, second = os.path.join(tmp, "1.db"), os.path.join(tmp, "2.db")
+            pruned_db(first, [("a.png", "b.png"), ("b.png", "c.png")], [("c.png", "d.png")])
+            pruned_db(second, second_kept, [], second_inliers)
+            return subprocess.run([sys.executable, SCRIPT, "same-selection", first, second],
+                                  capture_output=True).returncode
+
+    def test_the_same_pairs_with_the_same_inliers_are_the_same_selection(self):
+        # A dropped pair's row counts for nothing.
+        self.assertEqual(self.same([("b.png", "a.png"), ("b.png", "c.png")]), 0)
+
+    def test_another_pair_or_trimmed_inliers_are_not(self):
+        self.assertEqual(self.same([("a.png", "b.png"), ("c.png", "d.png")]), 1)
+        self.assertEqual(self.same([("a.png", "b.png"), ("b.png", "c.png")], b"\1" * 160), 1)
+
+
+if __name__ == "__main__":
+    unittest.main()
