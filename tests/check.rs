@@ -474,7 +474,7 @@ fn placements_agree_with_the_check(model: &Path, db: &Path, gt: &Path, report: &
 /// `check`; where it is not, the repair must change nothing a mapper would notice.
 fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let (eval, model, repaired) = repair_full_model(work, images, gt, "general", "repaired");
+    let (eval, model, repaired) = repair_full_model(work, images, gt);
     let first_report = s(&work.join("prune_repaired.json"));
     let full: Value =
         serde_json::from_str(&std::fs::read_to_string(work.join("eval_full.json")).unwrap())
@@ -503,25 +503,19 @@ fn repair_from_the_full_model(work: &Path, images: &Path, gt: &Path) {
     }
 }
 
-/// `prune --preset PRESET --model WORK/sparse_full` on the pipeline's full database into
-/// `WORK/NAME.db` (its report `WORK/prune_NAME.json`), `colmap mapper` on that into
-/// `WORK/sparse_NAME`, and the model's `eval` against `gt`: the eval, the model folder and the
-/// database.
-fn repair_full_model(
-    work: &Path,
-    images: &Path,
-    gt: &Path,
-    preset: &str,
-    name: &str,
-) -> (Value, PathBuf, PathBuf) {
+/// `prune --preset general --model WORK/sparse_full` on the pipeline's full database into
+/// `WORK/repaired.db` (its report `WORK/prune_repaired.json`), `colmap mapper` on that into
+/// `WORK/sparse_repaired`, and the model's `eval` against `gt`: the eval, the model folder and
+/// the database.
+fn repair_full_model(work: &Path, images: &Path, gt: &Path) -> (Value, PathBuf, PathBuf) {
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let repaired = work.join(format!("{name}.db"));
-    let model = work.join(format!("sparse_{name}"));
+    let repaired = work.join("repaired.db");
+    let model = work.join("sparse_repaired");
     let out = vgsel(&[
         "prune",
         "-q",
         "--preset",
-        preset,
+        "general",
         "--model",
         &s(&work.join("sparse_full")),
         "--database_path",
@@ -529,7 +523,7 @@ fn repair_full_model(
         "--output",
         &s(&repaired),
         "--report",
-        &s(&work.join(format!("prune_{name}.json"))),
+        &s(&work.join("prune_repaired.json")),
     ]);
     assert!(out.status.success(), "{out:?}");
     let mapper = colmap_mapper(&repaired, images, &model, None);
@@ -583,11 +577,11 @@ fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repa
 
 /// The repair loop on the hall (two identical objects each orbited all round in one room, 38
 /// images), COLMAP 3.8, through `scripts/pipeline.sh REPAIR=3`: the preset leaves a ghost; the
-/// first turn forbids the pairs that glued the copies (in the full model's ghost too) and keeps
-/// those that place the second orbit where the database's matches put it (the ghost's own
-/// placement refuted), or, where a
-/// turn leaves one clean model per orbit, `check` places the two in one frame and the next turn
-/// keeps the pairs that link them: one model, every camera correct. Where a turn leaves one
+/// first turn forbids the pairs that glued the copies (in the full model's ghost too, where the
+/// loop takes it) and keeps those that place the second orbit where the database's matches put
+/// it (the ghost's own placement refuted), or, where a turn leaves one clean model per orbit,
+/// `check` places the two in one frame and the next turn keeps the pairs that link them: one
+/// model, every camera correct. Where a turn leaves one
 /// camera on the object's look a quarter turn away (0023, 98 degrees off, in 4 of 6 fresh
 /// matchings of this scene), every pair of it true, the check calls it misplaced and the next
 /// turn drops the matches that held it there. About two to three minutes on 2 cores.
