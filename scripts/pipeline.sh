@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Images to two reconstructions: COLMAP features and exhaustive matching, a pruned copy of the
-# database by vgsel-colmap, `colmap mapper` on the full and on the pruned database, and (given a
+# database by vgsel-colmap, the mapper on the full and on the pruned database, and (given a
 # ground-truth model) `vgsel-colmap eval` of both. Prints one side-by-side table and writes
-# WORKDIR/summary.json.
+# WORKDIR/summary.json. COLMAP 3.8 (`colmap`) by default; COLMAP 4.2 through pycolmap (MATCHER,
+# MAPPER), in the venv scripts/ci/pycolmap-venv.sh makes.
 #
 # usage: scripts/pipeline.sh IMAGES WORKDIR [GT]
 #   IMAGES   folder of images (never modified; large images are downscaled by COLMAP for SIFT
@@ -15,6 +16,10 @@
 #   MAX_IMAGE_SIZE  SIFT image size [1024]       MAX_FEATURES  SIFT features per image [2048]
 #   CAMERA_MODEL    [SIMPLE_RADIAL]              CAMERA_PARAMS known intrinsics, e.g. "f,cx,cy" []
 #   SINGLE_CAMERA   one camera for all images [1]
+#   MATCHER         colmap3.8 (`colmap feature_extractor`, `exhaustive_matcher`) or pycolmap4.2
+#                   [colmap3.8]
+#   MAPPER          colmap3.8 (`colmap mapper`), or COLMAP 4.2's incremental or global mapper
+#                   (each run on a copy of its database, which COLMAP 4 would migrate) [colmap3.8]
 #   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
 #   REPAIR          N > 0: the repair loop (docs/check.md), at most N turns: `vgsel-colmap
 #                   check` on the last model, and where its report's `repair` is not empty
@@ -26,10 +31,10 @@
 #                   it is the first of those models and the first turn runs whatever the
 #                   pruned model's check says; a turn whose prune selects what the last run
 #                   mapped ends the loop; in the loop's runs, the pruned one's too,
-#                   the images the database links and the mapper left out (a piece the blame
-#                   cut off: COLMAP 3.8 starts no second model from narrow pairs) are mapped
-#                   on their own into sparse_VARIANT/left, counted in the mapper's seconds
-#                   (README); a turn whose mapper makes no model ends the loop, the model
+#                   the images the database links and COLMAP 3.8's mapper left out (a piece
+#                   the blame cut off: COLMAP 3.8 starts no second model from narrow pairs)
+#                   are mapped on their own into sparse_VARIANT/left, counted in the mapper's
+#                   seconds (README); a turn whose mapper makes no model ends the loop, the model
 #                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
 #                   loop_answer) is its last run the check calls clean, else its last run
 set -euo pipefail
@@ -43,6 +48,13 @@ prune_args=${PRUNE_ARGS---min_image_fraction 1 --min_pairs_per_image 5}
 bin=${VGSEL:-$here/target/release/vgsel-colmap}
 [ -x "$bin" ] || (cd "$here" && cargo build --release --quiet)
 log() { echo "pipeline: $*" >&2; }
+matcher=${MATCHER:-colmap3.8} mapper=${MAPPER:-colmap3.8}
+case "$matcher/$mapper" in
+  colmap3.8/colmap3.8 | */incremental | */global) ;;
+  pycolmap4.2/colmap3.8) echo "pipeline: COLMAP 3.8's mapper cannot read COLMAP 4's database" >&2; exit 2 ;;
+  *) echo "pipeline: MATCHER is colmap3.8 or pycolmap4.2, MAPPER colmap3.8, incremental or global" >&2; exit 2 ;;
+esac
+[ "$matcher/$mapper" = colmap3.8/colmap3.8 ] || py=$(bash "$here/scripts/ci/pycolmap-venv.sh")
 
 # Seconds taken by a command, its output going to a log file; fails with the log's tail, unless
 # the log says $tolerated (an outcome, not a failure; set for one call: `tolerated=... timed`).
@@ -61,20 +73,31 @@ timed() {
 
 if [ ! -f "$work/full.db.done" ]; then
   rm -f "$work/full.db"
-  camera=(--ImageReader.camera_model "${CAMERA_MODEL:-SIMPLE_RADIAL}"
-    --ImageReader.single_camera "${SINGLE_CAMERA:-1}")
-  [ -n "${CAMERA_PARAMS:-}" ] && camera+=(--ImageReader.camera_params "$CAMERA_PARAMS")
-  log "feature_extractor ($(ls "$images" | wc -l) images)"
-  t_extract=$(timed "$work/extract.log" colmap feature_extractor --database_path "$work/full.db" \
-    --image_path "$images" "${camera[@]}" --SiftExtraction.use_gpu 0 \
-    --SiftExtraction.max_image_size "${MAX_IMAGE_SIZE:-1024}" \
-    --SiftExtraction.max_num_features "${MAX_FEATURES:-2048}")
-  log "exhaustive_matcher"
-  t_match=$(timed "$work/match.log" colmap exhaustive_matcher --database_path "$work/full.db" \
-    --SiftMatching.use_gpu 0)
+  log "features and exhaustive matching by $matcher ($(ls "$images" | wc -l) images)"
+  if [ "$matcher" = colmap3.8 ]; then
+    camera=(--ImageReader.camera_model "${CAMERA_MODEL:-SIMPLE_RADIAL}"
+      --ImageReader.single_camera "${SINGLE_CAMERA:-1}")
+    [ -n "${CAMERA_PARAMS:-}" ] && camera+=(--ImageReader.camera_params "$CAMERA_PARAMS")
+    t_extract=$(timed "$work/extract.log" colmap feature_extractor --database_path "$work/full.db" \
+      --image_path "$images" "${camera[@]}" --SiftExtraction.use_gpu 0 \
+      --SiftExtraction.max_image_size "${MAX_IMAGE_SIZE:-1024}" \
+      --SiftExtraction.max_num_features "${MAX_FEATURES:-2048}")
+    t_match=$(timed "$work/match.log" colmap exhaustive_matcher --database_path "$work/full.db" \
+      --SiftMatching.use_gpu 0)
+  else
+    # pycolmap extracts and matches in one call: its seconds are the extraction's.
+    t_extract=$(timed "$work/extract.log" "$py" "$here/scripts/ci/colmap4.py" database "$images" \
+      "$work/full.db" --camera_model "${CAMERA_MODEL:-SIMPLE_RADIAL}" \
+      --single_camera "${SINGLE_CAMERA:-1}" --camera_params "${CAMERA_PARAMS:-}" \
+      --max_image_size "${MAX_IMAGE_SIZE:-1024}" --max_features "${MAX_FEATURES:-2048}")
+    t_match=0
+  fi
   echo "$t_extract $t_match" >"$work/full.db.done"
 fi
 read -r t_extract t_match <"$work/full.db.done"
+# A full model mapped by another mapper is mapped again.
+[ "$(cat "$work/full.mapper" 2>/dev/null)" = "$mapper" ] || rm -f "$work/sparse_full.seconds"
+echo "$mapper" >"$work/full.mapper"
 
 log "prune $prune_args"
 # shellcheck disable=SC2086 # PRUNE_ARGS is a list of options
@@ -101,18 +124,27 @@ map_and_eval() {
   if [ ! -f "$sparse.seconds" ]; then
     rm -rf "$sparse"
     mkdir -p "$sparse"
-    log "mapper on the $variant database"
-    # A repair turn's selection can leave COLMAP 3.8 no initial pair: that turn makes no model.
-    local outcome=
-    [[ $variant == repaired* ]] && outcome="failed to create sparse model"
-    tolerated=$outcome timed "$work/mapper_$variant.log" colmap mapper \
-      --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse" \
-      --Mapper.extract_colors 0 >"$sparse.seconds"
-    # The loop maps the images a run left out on their own before checking it, the pruned
-    # run's too: a piece that starts a model stays apart, only images that start none are
-    # placed by their matches (docs/check.md, "Cameras lost beside a clean model").
-    if [[ $variant == repaired* ]] || { [ "$variant" = pruned ] && [ "${REPAIR:-0}" -gt 0 ]; }; then
-      map_left_out "$variant"
+    log "$mapper mapper on the $variant database"
+    if [ "$mapper" = colmap3.8 ]; then
+      # A repair turn's selection can leave COLMAP 3.8 no initial pair: that turn makes no model.
+      local outcome=
+      [[ $variant == repaired* ]] && outcome="failed to create sparse model"
+      tolerated=$outcome timed "$work/mapper_$variant.log" colmap mapper \
+        --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse" \
+        --Mapper.extract_colors 0 >"$sparse.seconds"
+      # The loop maps the images a run left out on their own before checking it, the pruned
+      # run's too: a piece that starts a model stays apart, only images that start none are
+      # placed by their matches (docs/check.md, "Cameras lost beside a clean model").
+      if [[ $variant == repaired* ]] || { [ "$variant" = pruned ] && [ "${REPAIR:-0}" -gt 0 ]; }; then
+        map_left_out "$variant"
+      fi
+    else
+      # COLMAP 4 migrates the database it opens: it maps a copy, so that every database here
+      # stays as its matcher wrote it. No model at all is an outcome, an empty folder.
+      cp "$work/$variant.db" "$work/mapper_$variant.db"
+      timed "$work/mapper_$variant.log" "$py" "$here/scripts/ci/colmap4.py" map "$mapper" \
+        "$work/mapper_$variant.db" "$images" "$sparse" >"$sparse.seconds"
+      rm -f "$work/mapper_$variant.db"
     fi
   fi
   eval_args=(--model "$sparse" --database_path "$work/$variant.db")

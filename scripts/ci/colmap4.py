@@ -2,8 +2,10 @@
 """COLMAP 4 (pycolmap) steps for tests and measurements, run with the python of the venv that
 scripts/ci/pycolmap-venv.sh creates.
 
-  colmap4.py database IMAGES DB [--max_features N] [--camera_params f,cx,cy,k]
-      SIFT extraction (one SIMPLE_RADIAL camera, CPU) and exhaustive matching into a new DB.
+  colmap4.py database IMAGES DB [--max_features N] [--max_image_size N] [--camera_model M]
+                     [--camera_params PARAMS] [--single_camera 0|1]
+      SIFT extraction (CPU; one SIMPLE_RADIAL camera for all images by default) and exhaustive
+      matching into a new DB.
   colmap4.py open DB
       opens DB with COLMAP 4 and closes it: COLMAP migrates an older database in place.
   colmap4.py dump DB
@@ -26,16 +28,17 @@ def database(args):
     if os.path.exists(args.db):
         sys.exit(f"colmap4.py: {args.db} exists")
     reader = pycolmap.ImageReaderOptions()
-    reader.camera_model = "SIMPLE_RADIAL"
+    reader.camera_model = args.camera_model
     if args.camera_params:
         reader.camera_params = args.camera_params
     extraction = pycolmap.FeatureExtractionOptions()
     extraction.use_gpu = False
     extraction.sift.max_num_features = args.max_features
+    extraction.max_image_size = args.max_image_size
     pycolmap.extract_features(
         args.db,
         args.images,
-        camera_mode=pycolmap.CameraMode.SINGLE,
+        camera_mode=pycolmap.CameraMode.SINGLE if args.single_camera else pycolmap.CameraMode.AUTO,
         reader_options=reader,
         extraction_options=extraction,
         device=pycolmap.Device.cpu,
@@ -101,7 +104,10 @@ def main():
     p.add_argument("images")
     p.add_argument("db")
     p.add_argument("--max_features", type=int, default=1024)
+    p.add_argument("--max_image_size", type=int, default=-1)  # -1: COLMAP 4's own
+    p.add_argument("--camera_model", default="SIMPLE_RADIAL")
     p.add_argument("--camera_params", default="")
+    p.add_argument("--single_camera", type=int, choices=[0, 1], default=1)
     p.set_defaults(func=database)
     p = sub.add_parser("open")
     p.add_argument("db")
