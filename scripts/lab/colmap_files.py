@@ -1,11 +1,13 @@
 """What the measuring scripts read from COLMAP's files, in one place: a database's view graph
 (through the binary, never by SQL of their own), image names in capture order, and text models
-(camera centres, the 3D points each image sees, the points' positions); and the one way they
-make a database: a copy in which exactly chosen pairs stay valid (through `prune`).
+(camera centres, the 3D points each image sees, the points' positions); the runs of a repair
+loop's work folder; and the one way they make a database: a copy in which exactly chosen pairs
+stay valid (through `prune`).
 Standard library only, so that the system python runs it.
 """
 import contextlib
 import csv
+import glob
 import os
 import re
 import subprocess
@@ -130,3 +132,14 @@ def text_model(folder):
         subprocess.run(["colmap", "model_converter", "--input_path", folder, "--output_path", tmp,
                         "--output_type", "TXT"], check=True, capture_output=True)
         yield tmp
+
+
+def loop_runs(work):
+    """(model folder, its database, the full database, ground truth, eval report) of every run in
+    a scripts/lab/repair-loop.sh work folder. Each of its loops is a scripts/pipeline.sh work
+    folder, WORK/RUN/MATCHING/MAPPER, whose runs are full, pruned and repairedK."""
+    for ev in sorted(glob.glob(f"{work}/*/*/*/eval_*.json")):
+        loop = os.path.dirname(ev)
+        variant = os.path.basename(ev)[len("eval_"):-len(".json")]
+        yield (f"{loop}/sparse_{variant}", f"{loop}/{variant}.db", f"{loop}/full.db",
+               f"{work}/scene/gt", ev)

@@ -19,7 +19,6 @@ usage: VGSEL=target/release/vgsel-colmap scripts/lab/evidence-truth.py [--list] 
 """
 import collections
 import csv
-import glob
 import json
 import os
 import subprocess
@@ -33,12 +32,9 @@ MOVED = 0.05  # join::MISPLACED_DISTANCE: smaller moves are the model's own pose
 
 
 def turns(work):
-    """(model folder, its database, the run's full database, ground truth) per loop turn."""
-    for ev in sorted(glob.glob(f"{work}/*/*/*.eval.json")):
-        model = ev[: -len(".eval.json")]
-        mapper = os.path.basename(model).rsplit("_", 1)[0]
-        run = os.path.dirname(model)
-        yield model, f"{run}/{mapper}.db", f"{run}/full.db", f"{work}/scene/gt"
+    """(model folder, its database, the run's full database, ground truth) per loop run."""
+    for model, db, full_db, gt, _ in colmap_files.loop_runs(work):
+        yield model, db, full_db, gt
 
 
 def placements(work, tmp):

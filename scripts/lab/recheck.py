@@ -4,11 +4,9 @@ what a change to the check does to verdicts it gave before (docs/check.md, "One 
 wrong copy", "A misplaced group", "Unanchored images").
 
 Three kinds of work folder, as the lab scripts leave them:
-  --loops DIR ...   scripts/lab/repair-loop.sh's: MODEL.eval.json beside each turn's model, the
-                    database MAPPER.db beside it; truth: every registered camera correct. That
-                    database holds the last turn's selection: verdicts do not depend on which
-                    pairs are valid (every match counts, pruned or not), the reports' joining
-                    pairs of earlier turns do
+  --loops DIR ...   scripts/lab/repair-loop.sh's: every run of each loop (the full, pruned and
+                    repaired models, each with its database and eval); truth: every registered
+                    camera correct
   --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned, global_full,
                     global_pruned per scene with their databases; truth: SUB.eval.json's, per
                     sub-model, "unknown" without ground truth
@@ -31,18 +29,18 @@ import os
 import subprocess
 import tempfile
 
+import colmap_files
+
 VGSEL = os.environ.get("VGSEL", "target/release/vgsel-colmap")
 
 
 def models(args):
     """(set, truth, model folder, database) for every model at hand."""
     for work in args.loops:
-        for ev in sorted(glob.glob(f"{work}/*/*/*.eval.json")):
-            model = ev[: -len(".eval.json")]
-            mapper = os.path.basename(model).rsplit("_", 1)[0]
+        for model, db, _, _, ev in colmap_files.loop_runs(work):
             e = json.load(open(ev))
             truth = "correct" if e["correct"] == e["registered"] else "wrong"
-            yield "loops", truth, model, os.path.join(os.path.dirname(model), mapper + ".db")
+            yield "loops", truth, model, db
     for work in args.scenes:
         for scene in sorted(glob.glob(f"{work}/*/full.db")):
             d = os.path.dirname(scene)

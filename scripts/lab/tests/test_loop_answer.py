@@ -1,5 +1,5 @@
-"""loop_answer.py on loop.json rows written here: the last clean run answers, else the last run
-with a model."""
+"""loop_answer.py on loop.json rows written here: the loops whose answer is an earlier run than
+their last, and the cameras summed both ways."""
 import json
 import os
 import tempfile
@@ -15,19 +15,19 @@ def step(correct, **flags):
 
 
 class LoopAnswer(unittest.TestCase):
-    def test_the_last_clean_run_answers(self):
+    def test_answers_by_an_earlier_run_are_listed(self):
         loops = [
             # A clean run's join ends in a ghost: the clean run answers.
-            [step(21, ghosted=True), step(44), step(23, ghosted=True)],
+            ([step(21, ghosted=True), step(44), step(23, ghosted=True)], 1),
             # Nothing clean: the last run.
-            [step(20, ghosted=True), step(30, misplaced=True)],
+            ([step(20, ghosted=True), step(30, misplaced=True)], 1),
             # A turn made no model: the clean run before it.
-            [step(30, ghosted=True), step(40), step(0, no_model=True)],
+            ([step(30, ghosted=True), step(40), step(0, no_model=True)], 1),
             # Clean at the end: the last run.
-            [step(22, ghosted=True), step(44)],
+            ([step(22, ghosted=True), step(44)], 1),
         ]
-        rows = [{"run": k + 1, "matching": "colmap3.8", "mapper": "colmap3.8", "steps": s}
-                for k, s in enumerate(loops)]
+        rows = [{"run": k + 1, "matching": "colmap3.8", "mapper": "colmap3.8", "steps": s,
+                 "answer": a} for k, (s, a) in enumerate(loops)]
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "loop.json")
             with open(path, "w") as f:
