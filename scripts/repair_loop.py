@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Two decisions of the repair loop that scripts/pipeline.sh and scripts/lab/lab-measure.py share
-(docs/check.md, "The full model in the loop").
+"""Two decisions of scripts/pipeline.sh's repair loop, also for a loop run by hand (README,
+"Is the model ghosted?"; docs/check.md, "The full model in the loop").
 
 full-model: whether the loop takes the full database's model as evidence: where the check calls
 a model of it ghosted and its blame covers at least 40% of the pairs the pruned selection kept.

@@ -22,18 +22,11 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             labels true, the best a selection can hand that mapper; `keep=FILE`: exactly the
             verified pairs FILE lists, one `NAME1 NAME2` a line, e.g. another method's
             selection (scripts/bench/disambiguation-peers.sh), named by FILE's stem; `repair`:
-            the repair loop after the `disambiguation` run of the same variant, order and mapper:
-            `check` its model (with COLMAP 3.8, after mapping the images it left out on
-            their own, as every turn), and where its report's `repair` is not empty (a ghost,
-            a misplaced group or image, pieces to join, lost images to place) `prune --model`
-            with every model so far and map once more, at most REPAIR_TURNS times, as
-            scripts/pipeline.sh's loop: the `full` run's model is the first of those models
-            where `check` calls it ghosted and the first run kept what glued it
-            (scripts/repair_loop.py), and then the first turn runs whatever the
-            first run's check says; a turn that selects what the last run mapped ends the loop;
-            the record is the loop's answer,
-            its last run `check` calls clean, else its last (`last`: the last run); with COLMAP
-            3.8 each turn also maps the images it left out, scripts/map-left-out.sh); --order, default image_id; mapper colmap3.8
+            scripts/pipeline.sh's repair loop (REPAIR=3, the `disambiguation` preset with the
+            run's order and options, the run's mapper) on a copy of the variant's database, in
+            WORK/loop_TAG; the record is the loop's answer, its last run `check` calls clean,
+            else its last (`last`: the last run; `turns`: the turns taken));
+            --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).
 
@@ -72,11 +65,7 @@ import shutil
 import subprocess
 import sys
 
-import loop_answer
 from colmap_files import ROOT, VGSEL, natural, only_pairs, read_images, view_graph
-
-sys.path.append(os.path.join(ROOT, "scripts"))
-import repair_loop  # noqa: E402 (scripts/, found through ROOT)
 
 WINDOW = 3
 # The repair loop's turns at most (`repair` runs), as scripts/lab/repair-loop.sh's default.
@@ -115,21 +104,6 @@ def mapper(db, images, out):
         outcome="failed to create sparse model")
     os.remove(copy)
     open(out + ".done", "w").close()
-
-
-def map_left_out(db, images, out):
-    """A repair turn's second `colmap mapper` run (scripts/map-left-out.sh, as the README's
-    recipe and pipeline.sh have it): the images db links and out/ left out, into out/left, on a
-    copy of db, unless done before."""
-    if os.path.exists(out + ".left.done"):
-        return
-    copy = out + ".left.db"
-    shutil.copyfile(db, copy)
-    log(f"colmap mapper on the images {out} left out")
-    run(["env", f"VGSEL={VGSEL}", os.path.join(ROOT, "scripts", "map-left-out.sh"), copy, images,
-         out, "--Mapper.extract_colors", "0"])
-    os.remove(copy)
-    open(out + ".left.done", "w").close()
 
 
 @functools.lru_cache(maxsize=None)
@@ -327,93 +301,28 @@ def scored_run(images, work, dbs, spec):
                           db if preset == "full" else os.path.join(work, f"pruned_{tag}.db"))
         return result
     if preset == "repair":
-        result, models = scored_run(images, work, dbs, f"disambiguation:{variant}:{order}:{kind}"), []
-        if kind != "global":
-            # The loop's first run is that model with the images it left out mapped on their
-            # own, as every turn's (pipeline.sh): a piece that starts a model stays apart,
-            # and only images that start none are placed in it by their matches.
-            # Its model, database and prune report, taken as they are (not pruned and mapped
-            # again).
-            first, preset_tag = f"{tag}_turn0", f"disambiguation_{variant}_{order}"
-            sparse = os.path.join(work, f"sparse_{first}")
-            if not os.path.exists(sparse + ".done"):
-                shutil.rmtree(sparse, ignore_errors=True)
-                shutil.copytree(result["sparse"], sparse)
-                shutil.copyfile(result["database"], os.path.join(work, f"pruned_{first}.db"))
-                shutil.copyfile(os.path.join(work, f"prune_{preset_tag}.json"),
-                                os.path.join(work, f"prune_{first}.json"))
-                open(sparse + ".done", "w").close()
-            result = measured(images, work, db, variant, order, kind, [], None, first,
-                              "disambiguation", [], left_out=True)
-        # The full database's model, where the check calls a model of it ghosted and the
-        # first run's selection kept what glued it, is the first evidence of every turn, and
-        # the first turn runs whatever the first run's check says (as scripts/pipeline.sh;
-        # docs/check.md, "The full model in the loop").
-        full = scored_run(images, work, dbs, f"full:{variant}:{order}:{kind}")
-        checked(full, [])
-        full_evidence, _ = repair_loop.full_model(full["sparse"] + ".check.json",
-                                                  result["database"])
-        if full_evidence:
-            models = ["--model", full["sparse"]]
-        # Each checked run with its report, for the loop's answer (loop_answer.answer).
-        runs, reports, turns = [], [], 0
-        for turn in range(1, REPAIR_TURNS + 2):
-            # A turn whose mapper made no model (COLMAP 3.8 found no initial pair) ends the
-            # loop.
-            if not os.listdir(result["sparse"]):
-                break
-            runs.append(result)
-            reports.append(checked(result, models))
-            # Nothing for `prune --model` to act on, or no turn left: the loop stops here.
-            acts = any(reports[-1]["repair"].values()) or (turn == 1 and full_evidence)
-            if turn > REPAIR_TURNS or not acts:
-                break
-            models += ["--model", result["sparse"]]
-            turn_tag = tag if turn == 1 else f"{tag}_turn{turn}"
-            # A turn that selects what the last run mapped would only map it again.
-            pruned, _ = pruned_database(db, work, order, turn_tag, "disambiguation", extra, models)
-            if repair_loop.same_selection(result["database"], pruned):
-                break
-            result = measured(images, work, db, variant, order, kind, extra, None, turn_tag,
-                              "disambiguation", models)
-            turns += 1
-        answer = runs[loop_answer.answer(reports)] if runs else result
-        result = dict(answer, preset="repair", turns=turns, last=result["sparse"])
+        result = repair_loop(images, work, db, variant, order, kind, extra, tag)
         json.dump(result, open(path, "w"), indent=1)
         return result
-    result = measured(images, work, db, variant, order, kind, extra, listed, tag, preset, [])
+    result = measured(images, work, db, variant, order, kind, extra, listed, tag, preset)
     json.dump(result, open(path, "w"), indent=1)
     return result
 
 
-def checked(result, models):
-    """The check's report on a run's model (its database's evidence), after the loop's MODELS
-    (`--model DIR` pairs, passed as its earlier runs)."""
-    report = result["sparse"] + ".check.json"
-    earlier = ["--earlier_model" if a == "--model" else a for a in models]
-    done = subprocess.run([VGSEL, "check", "--model", result["sparse"], "--database_path",
-                           result["database"], *earlier, "--report", report], capture_output=True)
-    if done.returncode not in (0, 3):
-        sys.exit(f"lab-measure: check failed on {result['sparse']}: {done.stderr.decode()}")
-    return json.load(open(report))
-
-
-def pruned_database(db, work, order, tag, preset, extra, loop):
-    """DB pruned by PRESET (with EXTRA and LOOP's options) into WORK/pruned_TAG.db, done once:
-    that database and the prune's report."""
+def pruned_database(db, work, order, tag, preset, extra):
+    """DB pruned by PRESET (with EXTRA options) into WORK/pruned_TAG.db, done once: that
+    database and the prune's report."""
     pruned = os.path.join(work, f"pruned_{tag}.db")
     report = os.path.join(work, f"prune_{tag}.json")
     if not os.path.exists(report):
         run([VGSEL, "prune", "-q", "--database_path", db, "--output", pruned, "--overwrite",
-             "--preset", preset, "--order", order, "--report", report, *extra, *loop])
+             "--preset", preset, "--order", order, "--report", report, *extra])
     return pruned, json.load(open(report))
 
 
-def measured(images, work, db, variant, order, kind, extra, listed, tag, preset, loop,
-             left_out=False):
-    """One run, prune (PRESET with EXTRA and LOOP's options; `full`, `truth` or LISTED pairs
-    without), mapper and eval, its files named by TAG: its record. With COLMAP 3.8, a loop's
-    run (LOOP, or LEFT_OUT for its first) also maps the images it left out on their own."""
+def measured(images, work, db, variant, order, kind, extra, listed, tag, preset):
+    """One run, prune (PRESET with EXTRA options; `full`, `truth` or LISTED pairs without),
+    mapper and eval, its files named by TAG: its record."""
     if preset == "full":
         pruned, r = db, None
     elif preset == "truth":
@@ -421,11 +330,45 @@ def measured(images, work, db, variant, order, kind, extra, listed, tag, preset,
     elif listed:
         pruned, r = listed_pairs(db, work, variant, listed, tag), None
     else:
-        pruned, r = pruned_database(db, work, order, tag, preset, extra, loop)
+        pruned, r = pruned_database(db, work, order, tag, preset, extra)
     sparse = os.path.join(work, f"sparse_{tag}")
     (global_mapper if kind == "global" else mapper)(pruned, images, sparse)
-    if (loop or left_out) and kind != "global":
-        map_left_out(pruned, images, sparse)
+    return record(work, db, pruned, r, sparse,
+                  {"preset": preset, "variant": variant, "order": order, "mapper": kind,
+                   "prune_args": " ".join(extra)})
+
+
+def repair_loop(images, work, db, variant, order, kind, extra, tag):
+    """The repair loop after the `disambiguation` run: scripts/pipeline.sh's (REPAIR_TURNS
+    turns, MAPPER=kind), in WORK/loop_TAG with a copy of the variant's database as its full
+    one, done once. Its record is the loop's answer's, with its turns and last run."""
+    loop = os.path.join(work, f"loop_{tag}")
+    if not os.path.exists(os.path.join(loop, "answer")):
+        os.makedirs(loop, exist_ok=True)
+        shutil.copyfile(db, os.path.join(loop, "full.db"))
+        with open(os.path.join(loop, "full.db.done"), "w") as f:
+            f.write("0 0\n")  # matched before, not timed here
+        log(f"the repair loop (scripts/pipeline.sh) in {loop}")
+        prune_args = " ".join(["--preset", "disambiguation", "--order", order, *extra])
+        run(["env", f"VGSEL={VGSEL}", f"MAPPER={kind}", f"REPAIR={REPAIR_TURNS}",
+             f"PRUNE_ARGS={prune_args}", os.path.join(ROOT, "scripts", "pipeline.sh"), images,
+             loop, os.path.join(work, "truth_txt")], os.path.join(loop, "pipeline.log"))
+    answer = open(os.path.join(loop, "answer")).read().strip()
+    turns = sum(f.startswith("eval_repaired") for f in os.listdir(loop))
+    report = "prune.json" if answer == "pruned" else f"prune_{answer}.json"
+    r = json.load(open(os.path.join(loop, report)))
+    last = "pruned" if turns == 0 else f"repaired{turns}"
+    return dict(record(work, db, os.path.join(loop, f"{answer}.db"), r,
+                       os.path.join(loop, f"sparse_{answer}"),
+                       {"preset": "repair", "variant": variant, "order": order, "mapper": kind,
+                        "prune_args": " ".join(extra)}),
+                turns=turns, last=os.path.join(loop, f"sparse_{last}"))
+
+
+def record(work, db, pruned, r, sparse, run_keys):
+    """A run's record: RUN_KEYS (what ran), its model SPARSE and database PRUNED scored by `eval`
+    against the reference (pairs counted against DB, the variant's), with its prune report R
+    (None where no prune chose the pairs)."""
     txt = os.path.join(work, "truth_txt")
     model = any(d.isdigit() for d in os.listdir(sparse)) if os.path.isdir(sparse) else False
     # No model: the pairs are still counted (the reference stands in for the model).
@@ -435,8 +378,7 @@ def measured(images, work, db, variant, order, kind, extra, listed, tag, preset,
         e.update(models=0, registered=0, correct=0, images=[])
     uncertain = set(json.load(open(os.path.join(work, "truth.json")))["uncertain"])
     agreed = [i for i in e["images"] if i["name"] not in uncertain]
-    return {"preset": preset, "variant": variant, "order": order, "mapper": kind,
-            "prune_args": " ".join(extra), "sparse": sparse, "database": pruned,
+    return {**run_keys, "sparse": sparse, "database": pruned,
             "flow": r and r["flow"],
             "pairs_total": r["pairs_total"] if r else e["pairs"]["used"],
             "pairs_selected": r["pairs_selected"] if r else e["pairs"]["used"],
