@@ -237,7 +237,8 @@ def table(work, scenes):
         for (variant, preset), by_mapper in sorted(
                 rows.items(), key=lambda kv: (kv[0][0] != "order", kv[0][0],
                                               order.index(kv[0][1]) if kv[0][1] in order else 99)):
-            any_run = next(iter(by_mapper.values()))
+            # The pairs of COLMAP 3.8's run where both ran: a loop's answer differs by mapper.
+            any_run = by_mapper.get("colmap3.8") or next(iter(by_mapper.values()))
             threshold = ""
             sweep = os.path.join(work, scene, f"peers_{variant}", "sweep.json")
             if preset.endswith("-best") and os.path.exists(sweep):
