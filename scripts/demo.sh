@@ -7,7 +7,9 @@
 # a fresh machine; prints one side-by-side table. About 3 minutes on 2 cores without GPU.
 # usage: scripts/demo.sh [WORKDIR]   (default target/demo)
 # PRUNE_ARGS overrides the prune options (default: the disambiguation preset, as suits the scene);
-# NUM_IMAGES renders a larger scene (32 images: one COLMAP does not ghost).
+# NUM_IMAGES renders a larger scene (32 images: one COLMAP does not ghost). MAPPER, MATCHER and
+# REPAIR go to scripts/pipeline.sh: `MAPPER=global REPAIR=3` maps with COLMAP 4.2's global mapper
+# (pycolmap) and runs the repair loop.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/ci/install-deps.sh

@@ -356,3 +356,62 @@ fn python_recipe_prunes_between_matching_and_mapping() {
     assert_eq!(inspect["pruned_by_vgsel_colmap"], true, "{inspect}");
     assert!(work.join("sparse/0/images.bin").exists());
 }
+
+/// `scripts/pipeline.sh` for a COLMAP 4 user (`MATCHER=pycolmap4.2 MAPPER=incremental`, one
+/// turn of the loop at most): pycolmap extracts with the camera and SIFT options given, the
+/// prune and the check run on its database, and COLMAP 4.2's incremental mapper registers all
+/// 20 demo cameras right (10 of 10 fresh matchings in the README).
+#[test]
+fn pipeline_runs_the_loop_with_colmap4_from_images_to_models() {
+    let Some(f) = fixture() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path().join("work");
+    let out = Command::new("bash")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/pipeline.sh"))
+        .args([&f.images, &work, &f.gt])
+        .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .env("MATCHER", "pycolmap4.2")
+        .env("MAPPER", "incremental")
+        .env("REPAIR", "1")
+        .env("MAX_FEATURES", "1024")
+        .env("CAMERA_PARAMS", "400,240,180,0")
+        .env("PRUNE_ARGS", "--preset disambiguation")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let db = work.join("full.db");
+    assert_eq!(user_version(&db), 4020100);
+    let conn = rusqlite::Connection::open(&db).unwrap();
+    let (cameras, model, params): (i64, i64, Vec<u8>) = conn
+        .query_row("SELECT count(*), model, params FROM cameras", [], |r| {
+            Ok((r.get(0)?, r.get(1)?, r.get(2)?))
+        })
+        .unwrap();
+    let params: Vec<f64> = params
+        .chunks(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    // One SIMPLE_RADIAL camera (model 2) with the intrinsics given.
+    assert_eq!(
+        (cameras, model, params),
+        (1, 2, vec![400.0, 240.0, 180.0, 0.0])
+    );
+    // SIFT at 1024 features, as the fixture's database was extracted (the pipeline's own
+    // default is 2048): the same keypoints.
+    let keypoints = |db: &Path| -> i64 {
+        rusqlite::Connection::open(db)
+            .unwrap()
+            .query_row("SELECT sum(rows) FROM keypoints", [], |r| r.get(0))
+            .unwrap()
+    };
+    assert_eq!(keypoints(&db), keypoints(&f.db42));
+    let log = std::fs::read_to_string(work.join("mapper_pruned.log")).unwrap();
+    assert!(log.contains(r#""mapper": "incremental""#), "{log}");
+    assert!(work.join("check_pruned.json").exists());
+    let answer = std::fs::read_to_string(work.join("answer")).unwrap();
+    let eval: Value = serde_json::from_str(
+        &std::fs::read_to_string(work.join(format!("eval_{}.json", answer.trim()))).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(eval["correct"], 20, "{eval}");
+}
