@@ -24,6 +24,9 @@ usage:
       per method, from a table the `table` command printed: the cells with one correct model,
       those with every camera correct in any number of models, the median (over the table's
       rows) of the false and the true pairs kept, and the models `check` flagged.
+  disambiguation_peers.py matchings TABLE.md...    (any python 3)
+      per method, over tables of several matchings of the same scenes (one WORK each): in how
+      many of them each scene and mapper gave one correct model.
 
 Settings: the checkout's README and its notebooks for the small yan2017 scenes. Yan: track
 degree 3, coverage 0.9, alpha 0.1, at least 5 shared unique tracks, pairs kept at a score >= 0.3
@@ -252,6 +255,15 @@ def table(work, scenes):
                   f"| {' | '.join(cells)} |")
 
 
+def table_rows(path):
+    """The rows of a table `table` printed (PATH), each its list of cells: scene, ids, method,
+    threshold, pairs, false kept, true kept, COLMAP 3.8, COLMAP 4.2 global."""
+    for line in open(path):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("| ") and cells[0] != "scene" and len(cells) >= 9:
+            yield cells
+
+
 def summary(path):
     """What a user can expect from each method, from a table `table` printed (PATH): per method,
     the cells (scene, id order, mapper) with one correct model, those where every camera is
@@ -259,10 +271,7 @@ def summary(path):
     of the false and the true pairs kept, and the models `check` flagged: correct ones / the
     others."""
     methods, rows = [], {}
-    for line in open(path):
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if not line.startswith("| ") or cells[0] == "scene" or len(cells) < 9:
-            continue
+    for cells in table_rows(path):
         if cells[2] not in rows:
             methods.append(cells[2])
         r = rows.setdefault(cells[2], {"correct": 0, "every": 0, "cells": 0, "false": [],
@@ -288,11 +297,35 @@ def summary(path):
               f"| {100 * statistics.median(r['true']):.0f}% | {r['flagged'][0]} / {r['flagged'][1]} |")
 
 
+def matchings(paths):
+    """Per method, over several tables `table` printed (PATHS, one per matching of the same
+    scenes): in how many of them each scene and mapper gave one correct model. One matching
+    tells the methods apart only where they differ on every matching."""
+    methods, scenes, hits = [], [], {}
+    for path in paths:
+        for cells in table_rows(path):
+            scene = cells[0] if cells[1] == "capture" else f"{cells[0]} ({cells[1]})"
+            for name, into in ((cells[2], methods), (scene, scenes)):
+                if name not in into:
+                    into.append(name)
+            for mapper, cell in zip(("3.8", "global"), cells[7:9]):
+                hits.setdefault((cells[2], scene, mapper), []).append(cell.startswith("**"))
+    columns = [(scene, mapper) for scene in scenes for mapper in ("3.8", "global")]
+    print(f"| method | {' | '.join(f'{s} {m}' for s, m in columns)} | all |")
+    print(f"|---|{'---:|' * (len(columns) + 1)}")
+    for method in methods:
+        counts = [hits.get((method, s, m), []) for s, m in columns]
+        print(f"| {method} | {' | '.join(f'{sum(c)}/{len(c)}' for c in counts)} "
+              f"| {sum(map(sum, counts))}/{sum(map(len, counts))} |")
+
+
 def main(argv):
     commands = {"scores": (scores, 3), "select": (select, 3), "calibrator": (calibrator, 2),
                 "summary": (summary, 1)}
     if argv and argv[0] == "table" and len(argv) >= 3:
         return table(argv[1], argv[2:])
+    if argv and argv[0] == "matchings" and len(argv) >= 2:
+        return matchings(argv[1:])
     if not argv or argv[0] not in commands or len(argv) != commands[argv[0]][1] + 1:
         sys.exit(__doc__)
     commands[argv[0]][0](*argv[1:])

@@ -1,5 +1,6 @@
-"""disambiguation_peers.py summary (scripts/bench): the README's per-method summary of a peers
-table, on a table written here."""
+"""disambiguation_peers.py summary and matchings (scripts/bench): the README's per-method summary
+of a peers table, and one correct model counted over the tables of several matchings, on tables
+written here."""
 import os
 import subprocess
 import sys
@@ -34,6 +35,26 @@ class Summary(unittest.TestCase):
         self.assertEqual(out[2], "| full database | 1 | 1 | 100% | 100% | 0 / 1 |")
         # false: 0/4 and 1/10 -> median 5%; true: 3/6 and 4/10 -> 45%
         self.assertEqual(out[3], "| ours | 3 | 4 | 5% | 45% | 0 / 0 |")
+
+    def test_matchings_count_each_scene_and_mapper_over_the_tables(self):
+        """a: ours right in both tables with COLMAP 3.8; the full database once with the global
+        mapper; b (shuffled ids) a scene of its own."""
+        second = TABLE.replace("| a | capture | full database |  | 10 | 4 of 4 | 6 of 6 | 3/5 · "
+                               "flagged | **5/5** · clean |",
+                               "| a | capture | full database |  | 10 | 4 of 4 | 6 of 6 | 3/5 · "
+                               "flagged | 4/5 · clean |").replace("| b | capture", "| b | shuffled")
+        with tempfile.TemporaryDirectory() as tmp:
+            paths = []
+            for k, text in enumerate((TABLE, second)):
+                paths.append(os.path.join(tmp, f"table{k}.md"))
+                with open(paths[-1], "w") as f:
+                    f.write(text)
+            out = subprocess.run([sys.executable, BENCH, "matchings", *paths],
+                                 capture_output=True, text=True, check=True).stdout.splitlines()
+        self.assertEqual(out[0], "| method | a 3.8 | a global | b 3.8 | b global | "
+                                 "b (shuffled) 3.8 | b (shuffled) global | all |")
+        self.assertEqual(out[2], "| full database | 0/2 | 1/2 | 0/1 | 0/1 | 0/1 | 0/1 | 1/8 |")
+        self.assertEqual(out[3], "| ours | 2/2 | 2/2 | 1/1 | 0/1 | 1/1 | 0/1 | 6/8 |")
 
 
 if __name__ == "__main__":
