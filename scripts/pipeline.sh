@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Images to two reconstructions: COLMAP features and exhaustive matching, a pruned copy of the
 # database by vgsel-colmap, the mapper on the full and on the pruned database, and (given a
-# ground-truth model) `vgsel-colmap eval` of both. Prints one side-by-side table and writes
-# WORKDIR/summary.json. COLMAP 3.8 (`colmap`) by default; COLMAP 4.2 through pycolmap (MATCHER,
+# ground-truth model) `vgsel-colmap eval` of both. Prints one side-by-side table (with REPAIR,
+# each run's `check` verdict too) and writes WORKDIR/summary.json. COLMAP 3.8 (`colmap`) by default; COLMAP 4.2 through pycolmap (MATCHER,
 # MAPPER), in the venv scripts/ci/pycolmap-venv.sh makes.
 #
 # usage: scripts/pipeline.sh IMAGES WORKDIR [GT]
@@ -154,7 +154,8 @@ map_and_eval() {
 }
 map_and_eval full
 map_and_eval pruned
-rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer"
+rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer" \
+  "$work"/check_*.json
 last=pruned models=() earlier=() answer= full_evidence=
 # The full database's model is evidence too where the check calls it ghosted and the pruned
 # selection kept what glued it: the pruned model can be the same ghost, hidden from the check
@@ -230,14 +231,26 @@ for v in ["full", "pruned"] + [f"repaired{k}" for k in turns]:
     e["mapper_seconds"] = float(open(f"{work}/sparse_{v}.seconds").read())
     rows[v] = e
 fmt = lambda x, f: "-" if x is None else f % x
+
+
+def verdict(variant):
+    """`check`'s verdict on the run's models (the loop's check), "-" where it did not run."""
+    try:
+        c = json.load(open(f"{work}/check_{variant}.json"))
+    except FileNotFoundError:
+        return "-"
+    return next((k for k in ("ghosted", "misplaced", "unanchored", "folded") if c.get(k)), "clean")
+
+
 print(f"{'database':<10} {'pairs':>6} {'mapper s':>9} {'models':>6} {'registered':>10} "
-      f"{'correct':>7} {'med. pos':>9} {'med. rot':>9} {'false pairs':>11}")
+      f"{'correct':>7} {'med. pos':>9} {'med. rot':>9} {'false pairs':>11} {'check':>10}")
 for v, e in rows.items():
     p = e.get("pairs") or {}
     print(f"{v:<10} {e['pairs_used']:>6} {e['mapper_seconds']:>9.1f} {e['models']:>6} "
           f"{str(e['registered']) + '/' + str(e['images_total']):>10} "
           f"{fmt(e.get('correct'), '%d'):>7} {fmt(e.get('median_position_error'), '%.4f'):>9} "
-          f"{fmt(e.get('median_rotation_error_deg'), '%.2f°'):>9} {fmt(p.get('false'), '%d'):>11}")
+          f"{fmt(e.get('median_rotation_error_deg'), '%.2f°'):>9} {fmt(p.get('false'), '%d'):>11} "
+          f"{verdict(v):>10}")
 summary = {"extract_seconds": t_extract, "match_seconds": t_match,
            "prune": json.load(open(f"{work}/prune.json")), **rows}
 if os.path.exists(f"{work}/answer"):
