@@ -34,7 +34,8 @@
 #                   the images the database links and COLMAP 3.8's mapper left out (a piece
 #                   the blame cut off: COLMAP 3.8 starts no second model from narrow pairs)
 #                   are mapped on their own into sparse_VARIANT/left, counted in the mapper's
-#                   seconds (README); a turn whose mapper makes no model ends the loop, the model
+#                   seconds (README); a run whose mapper makes no model (COLMAP 3.8 found no
+#                   initial pair: an outcome, recorded as such) ends the loop, the model
 #                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
 #                   loop_answer) is its last run the check calls clean, else its last run
 set -euo pipefail
@@ -114,8 +115,8 @@ map_left_out() {
     "$work/$variant.db" "$images" "$sparse" --Mapper.extract_colors 0)
   [ -s "$sparse.left.txt" ] &&
     log "mapper on the $(wc -l <"$sparse.left.txt") images the $variant model left out"
-  first=$(cat "$sparse.seconds")
-  echo "$first + $seconds" | bc >"$sparse.seconds"
+  first=$(cat "$sparse.seconds.part")
+  echo "$first + $seconds" | bc >"$sparse.seconds.part"
 }
 
 # The mapper on one database of WORKDIR (full, pruned or repaired) and the eval of its model.
@@ -126,12 +127,11 @@ map_and_eval() {
     mkdir -p "$sparse"
     log "$mapper mapper on the $variant database"
     if [ "$mapper" = colmap3.8 ]; then
-      # A repair turn's selection can leave COLMAP 3.8 no initial pair: that turn makes no model.
-      local outcome=
-      [[ $variant == repaired* ]] && outcome="failed to create sparse model"
-      tolerated=$outcome timed "$work/mapper_$variant.log" colmap mapper \
+      # COLMAP 3.8 can find no initial pair (a repair turn's selection, or a scene it cannot
+      # start at all): that run makes no model, an outcome.
+      tolerated="failed to create sparse model" timed "$work/mapper_$variant.log" colmap mapper \
         --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse" \
-        --Mapper.extract_colors 0 >"$sparse.seconds"
+        --Mapper.extract_colors 0 >"$sparse.seconds.part"
       # The loop maps the images a run left out on their own before checking it, the pruned
       # run's too: a piece that starts a model stays apart, only images that start none are
       # placed by their matches (docs/check.md, "Cameras lost beside a clean model").
@@ -143,9 +143,11 @@ map_and_eval() {
       # stays as its matcher wrote it. No model at all is an outcome, an empty folder.
       cp "$work/$variant.db" "$work/mapper_$variant.db"
       timed "$work/mapper_$variant.log" "$py" "$here/scripts/ci/colmap4.py" map "$mapper" \
-        "$work/mapper_$variant.db" "$images" "$sparse" >"$sparse.seconds"
+        "$work/mapper_$variant.db" "$images" "$sparse" >"$sparse.seconds.part"
       rm -f "$work/mapper_$variant.db"
     fi
+    # The seconds mark the run done: written once it is (a failed run leaves none).
+    mv "$sparse.seconds.part" "$sparse.seconds"
   fi
   eval_args=(--model "$sparse" --database_path "$work/$variant.db")
   [ -n "$gt" ] && eval_args+=(--ground_truth "$gt")
@@ -161,7 +163,7 @@ last=pruned models=() earlier=() answer= full_evidence=
 # selection kept what glued it: the pruned model can be the same ghost, hidden from the check
 # (the twin: docs/check.md, "The full model in the loop", scripts/repair_loop.py), so
 # its blame joins every turn's and the loop takes its first turn.
-if [ "${REPAIR:-0}" -gt 0 ]; then
+if [ "${REPAIR:-0}" -gt 0 ] && [ -n "$(ls -A "$work/sparse_full")" ]; then
   status=0
   "$bin" check --model "$work/sparse_full" --database_path "$work/full.db" \
     --report "$work/check_full.json" >"$work/check_full.txt" || status=$?
@@ -179,6 +181,10 @@ fi
 # place a misplaced group, join clean models or place an image no model registered).
 for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   [ "${REPAIR:-0}" -gt 0 ] || break
+  if [ -z "$(ls -A "$work/sparse_$last")" ]; then
+    log "the $last run made no model: nothing to check"
+    break
+  fi
   status=0
   "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" "${earlier[@]}" \
     --report "$work/check_$last.json" >"$work/check_$last.txt" || status=$?
