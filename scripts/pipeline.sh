@@ -2,7 +2,8 @@
 # Images to two reconstructions: COLMAP features and exhaustive matching, a pruned copy of the
 # database by vgsel-colmap, the mapper on the full and on the pruned database, and (given a
 # ground-truth model) `vgsel-colmap eval` of both. Prints one side-by-side table (with REPAIR,
-# each run's `check` verdict too) and writes WORKDIR/summary.json. COLMAP 3.8 (`colmap`) by default; COLMAP 4.2 through pycolmap (MATCHER,
+# each run's `check` verdict too) and writes WORKDIR/summary.json (each run's eval under its
+# name, full, pruned, repairedK, in that order, with its `check` verdict; the loop's answer). COLMAP 3.8 (`colmap`) by default; COLMAP 4.2 through pycolmap (MATCHER,
 # MAPPER), in the venv scripts/ci/pycolmap-venv.sh makes.
 #
 # usage: scripts/pipeline.sh IMAGES WORKDIR [GT]
@@ -16,6 +17,8 @@
 #   MAX_IMAGE_SIZE  SIFT image size [1024]       MAX_FEATURES  SIFT features per image [2048]
 #   CAMERA_MODEL    [SIMPLE_RADIAL]              CAMERA_PARAMS known intrinsics, e.g. "f,cx,cy" []
 #   SINGLE_CAMERA   one camera for all images [1]
+#   DATABASE        a database already matched from IMAGES: copied as WORKDIR/full.db (read,
+#                   never changed) instead of extracting and matching []
 #   MATCHER         colmap3.8 (`colmap feature_extractor`, `exhaustive_matcher`) or pycolmap4.2
 #                   [colmap3.8]
 #   MAPPER          colmap3.8 (`colmap mapper`), or COLMAP 4.2's incremental or global mapper
@@ -74,8 +77,15 @@ timed() {
 
 if [ ! -f "$work/full.db.done" ]; then
   rm -f "$work/full.db"
-  log "features and exhaustive matching by $matcher ($(ls "$images" | wc -l) images)"
-  if [ "$matcher" = colmap3.8 ]; then
+  if [ -n "${DATABASE:-}" ]; then
+    log "the matched database $DATABASE, copied"
+    # SQLite's backup, opened read-only: a copy whole even where the source has a -wal file.
+    python3 -c 'import sqlite3, sys
+sqlite3.connect(f"file:{sys.argv[1]}?mode=ro", uri=True).backup(sqlite3.connect(sys.argv[2]))' \
+      "$DATABASE" "$work/full.db"
+    t_extract=0 t_match=0
+  elif [ "$matcher" = colmap3.8 ]; then
+    log "features and exhaustive matching by $matcher ($(ls "$images" | wc -l) images)"
     camera=(--ImageReader.camera_model "${CAMERA_MODEL:-SIMPLE_RADIAL}"
       --ImageReader.single_camera "${SINGLE_CAMERA:-1}")
     [ -n "${CAMERA_PARAMS:-}" ] && camera+=(--ImageReader.camera_params "$CAMERA_PARAMS")
@@ -86,6 +96,7 @@ if [ ! -f "$work/full.db.done" ]; then
     t_match=$(timed "$work/match.log" colmap exhaustive_matcher --database_path "$work/full.db" \
       --SiftMatching.use_gpu 0)
   else
+    log "features and exhaustive matching by $matcher ($(ls "$images" | wc -l) images)"
     # pycolmap extracts and matches in one call: its seconds are the extraction's.
     t_extract=$(timed "$work/extract.log" "$py" "$here/scripts/ci/colmap4.py" database "$images" \
       "$work/full.db" --camera_model "${CAMERA_MODEL:-SIMPLE_RADIAL}" \
@@ -226,17 +237,6 @@ fi
 python3 - "$work" "$t_extract" "$t_match" <<'EOF'
 import json, os, sys
 work, t_extract, t_match = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
-rows = {}
-turns = sorted(int(f[len("eval_repaired"):-5]) for f in os.listdir(work)
-               if f.startswith("eval_repaired") and f.endswith(".json"))
-for v in ["full", "pruned"] + [f"repaired{k}" for k in turns]:
-    try:
-        e = json.load(open(f"{work}/eval_{v}.json"))
-    except FileNotFoundError:
-        continue
-    e["mapper_seconds"] = float(open(f"{work}/sparse_{v}.seconds").read())
-    rows[v] = e
-fmt = lambda x, f: "-" if x is None else f % x
 
 
 def verdict(variant):
@@ -248,6 +248,19 @@ def verdict(variant):
     return next((k for k in ("ghosted", "misplaced", "unanchored", "folded") if c.get(k)), "clean")
 
 
+rows = {}
+turns = sorted(int(f[len("eval_repaired"):-5]) for f in os.listdir(work)
+               if f.startswith("eval_repaired") and f.endswith(".json"))
+for v in ["full", "pruned"] + [f"repaired{k}" for k in turns]:
+    try:
+        e = json.load(open(f"{work}/eval_{v}.json"))
+    except FileNotFoundError:
+        continue
+    e["mapper_seconds"] = float(open(f"{work}/sparse_{v}.seconds").read())
+    e["check"] = verdict(v)
+    rows[v] = e
+fmt = lambda x, f: "-" if x is None else f % x
+
 print(f"{'database':<10} {'pairs':>6} {'mapper s':>9} {'models':>6} {'registered':>10} "
       f"{'correct':>7} {'med. pos':>9} {'med. rot':>9} {'false pairs':>11} {'check':>10}")
 for v, e in rows.items():
@@ -256,7 +269,7 @@ for v, e in rows.items():
           f"{str(e['registered']) + '/' + str(e['images_total']):>10} "
           f"{fmt(e.get('correct'), '%d'):>7} {fmt(e.get('median_position_error'), '%.4f'):>9} "
           f"{fmt(e.get('median_rotation_error_deg'), '%.2f°'):>9} {fmt(p.get('false'), '%d'):>11} "
-          f"{verdict(v):>10}")
+          f"{e['check']:>10}")
 summary = {"extract_seconds": t_extract, "match_seconds": t_match,
            "prune": json.load(open(f"{work}/prune.json")), **rows}
 if os.path.exists(f"{work}/answer"):

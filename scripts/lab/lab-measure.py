@@ -343,26 +343,24 @@ def repair_loop(images, work, db, variant, order, kind, extra, tag):
     turns, MAPPER=kind), in WORK/loop_TAG with a copy of the variant's database as its full
     one, done once. Its record is the loop's answer's, with its turns and last run."""
     loop = os.path.join(work, f"loop_{tag}")
-    if not os.path.exists(os.path.join(loop, "answer")):
-        os.makedirs(loop, exist_ok=True)
-        shutil.copyfile(db, os.path.join(loop, "full.db"))
-        with open(os.path.join(loop, "full.db.done"), "w") as f:
-            f.write("0 0\n")  # matched before, not timed here
+    if not os.path.exists(os.path.join(loop, "summary.json")):
         log(f"the repair loop (scripts/pipeline.sh) in {loop}")
+        os.makedirs(loop, exist_ok=True)
         prune_args = " ".join(["--preset", "disambiguation", "--order", order, *extra])
-        run(["env", f"VGSEL={VGSEL}", f"MAPPER={kind}", f"REPAIR={REPAIR_TURNS}",
-             f"PRUNE_ARGS={prune_args}", os.path.join(ROOT, "scripts", "pipeline.sh"), images,
-             loop, os.path.join(work, "truth_txt")], os.path.join(loop, "pipeline.log"))
-    answer = open(os.path.join(loop, "answer")).read().strip()
-    turns = sum(f.startswith("eval_repaired") for f in os.listdir(loop))
+        run(["env", f"VGSEL={VGSEL}", f"DATABASE={db}", f"MAPPER={kind}",
+             f"REPAIR={REPAIR_TURNS}", f"PRUNE_ARGS={prune_args}",
+             os.path.join(ROOT, "scripts", "pipeline.sh"), images, loop,
+             os.path.join(work, "truth_txt")], os.path.join(loop, "pipeline.log"))
+    summary = json.load(open(os.path.join(loop, "summary.json")))
+    answer = summary["loop_answer"]
+    runs = [v for v in summary if v == "pruned" or v.startswith("repaired")]
     report = "prune.json" if answer == "pruned" else f"prune_{answer}.json"
     r = json.load(open(os.path.join(loop, report)))
-    last = "pruned" if turns == 0 else f"repaired{turns}"
     return dict(record(work, db, os.path.join(loop, f"{answer}.db"), r,
                        os.path.join(loop, f"sparse_{answer}"),
                        {"preset": "repair", "variant": variant, "order": order, "mapper": kind,
                         "prune_args": " ".join(extra)}),
-                turns=turns, last=os.path.join(loop, f"sparse_{last}"))
+                turns=len(runs) - 1, last=os.path.join(loop, f"sparse_{runs[-1]}"))
 
 
 def record(work, db, pruned, r, sparse, run_keys):
