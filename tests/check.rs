@@ -153,18 +153,13 @@ fn pipeline(kind: SceneKind, num_images: usize, repair: u32) -> (tempfile::TempD
 /// mapper through pycolmap); the matching of an earlier run in `dir/work` is reused.
 fn run_pipeline(dir: &Path, repair: u32, mapper: &str) -> PathBuf {
     let work = dir.join("work");
-    let out = Command::new("bash")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/pipeline.sh"))
-        .args([dir.join("images"), work.clone(), dir.join("gt")])
-        .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
-        .env("MAX_FEATURES", "1024")
-        .env("PRUNE_ARGS", "--preset disambiguation")
-        .env("CAMERA_PARAMS", "400,240,180,0")
-        .env("REPAIR", repair.to_string())
-        .env("MAPPER", mapper)
-        .output()
-        .expect("running scripts/pipeline.sh");
-    assert!(out.status.success(), "pipeline failed: {out:?}");
+    let repair = repair.to_string();
+    crate::support::pipeline_sh(
+        &dir.join("images"),
+        &work,
+        &dir.join("gt"),
+        &[("REPAIR", &repair), ("MAPPER", mapper)],
+    );
     work
 }
 

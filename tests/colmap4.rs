@@ -366,19 +366,12 @@ fn pipeline_runs_the_loop_with_colmap4_from_images_to_models() {
     let Some(f) = fixture() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let work = tmp.path().join("work");
-    let out = Command::new("bash")
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/pipeline.sh"))
-        .args([&f.images, &work, &f.gt])
-        .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
-        .env("MATCHER", "pycolmap4.2")
-        .env("MAPPER", "incremental")
-        .env("REPAIR", "1")
-        .env("MAX_FEATURES", "1024")
-        .env("CAMERA_PARAMS", "400,240,180,0")
-        .env("PRUNE_ARGS", "--preset disambiguation")
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{out:?}");
+    let env = [
+        ("MATCHER", "pycolmap4.2"),
+        ("MAPPER", "incremental"),
+        ("REPAIR", "1"),
+    ];
+    crate::support::pipeline_sh(&f.images, &work, &f.gt, &env);
     let db = work.join("full.db");
     assert_eq!(user_version(&db), 4020100);
     let conn = rusqlite::Connection::open(&db).unwrap();

@@ -399,3 +399,20 @@ pub fn run_versions(path: &Path) -> Vec<Option<i64>> {
         .map(Result::unwrap)
         .collect()
 }
+
+/// `scripts/pipeline.sh IMAGES WORK GT` on a rendered scene as the tests run it: this build's
+/// binary, `--preset disambiguation`, 1024 SIFT features and the renderer's intrinsics, with
+/// `env` (REPAIR, MAPPER, MATCHER, ...) on top. Panics with its output unless it succeeds.
+pub fn pipeline_sh(images: &Path, work: &Path, gt: &Path, env: &[(&str, &str)]) {
+    let out = std::process::Command::new("bash")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/pipeline.sh"))
+        .args([images, work, gt])
+        .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .env("MAX_FEATURES", "1024")
+        .env("PRUNE_ARGS", "--preset disambiguation")
+        .env("CAMERA_PARAMS", "400,240,180,0")
+        .envs(env.iter().copied())
+        .output()
+        .expect("running scripts/pipeline.sh");
+    assert!(out.status.success(), "pipeline failed: {out:?}");
+}
