@@ -135,31 +135,24 @@ fn check_with(model: &Path, db: &Path, more: &[&str], left: &Path) -> Output {
 }
 
 /// The rendered scene `kind` (`num_images`, seed 1) in a temporary folder, run through
-/// `scripts/pipeline.sh` with COLMAP 3.8 and `REPAIR=repair` turns of the loop
-/// ([`run_pipeline`]): the folder and the pipeline's work folder.
+/// `scripts/pipeline.sh` with COLMAP 3.8 and `REPAIR=repair` turns of the loop into its `work`
+/// folder ([`run_pipeline`]): the folder and the pipeline's work folder.
 fn pipeline(kind: SceneKind, num_images: usize, repair: u32) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     Scene::build(kind, num_images, 1)
         .unwrap()
         .write(dir.path())
         .unwrap();
-    let work = run_pipeline(dir.path(), repair, "colmap3.8");
+    let work = run_pipeline(dir.path(), "work", &[("REPAIR", &repair.to_string())]);
     (dir, work)
 }
 
 /// `scripts/pipeline.sh` on the scene written in `dir` (its images and gt), into `dir/work`,
-/// with `--preset disambiguation`, `REPAIR=repair` turns of the loop, 1024 SIFT features, the
-/// renderer's intrinsics and `MAPPER=mapper` (colmap3.8, or COLMAP 4.2's incremental or global
-/// mapper through pycolmap); the matching of an earlier run in `dir/work` is reused.
-fn run_pipeline(dir: &Path, repair: u32, mapper: &str) -> PathBuf {
-    let work = dir.join("work");
-    let repair = repair.to_string();
-    crate::support::pipeline_sh(
-        &dir.join("images"),
-        &work,
-        &dir.join("gt"),
-        &[("REPAIR", &repair), ("MAPPER", mapper)],
-    );
+/// with `--preset disambiguation`, 1024 SIFT features, the renderer's intrinsics and `env`
+/// (REPAIR, MAPPER, DATABASE, ...) on top.
+fn run_pipeline(dir: &Path, work: &str, env: &[(&str, &str)]) -> PathBuf {
+    let work = dir.join(work);
+    crate::support::pipeline_sh(&dir.join("images"), &work, &dir.join("gt"), env);
     work
 }
 
@@ -672,12 +665,34 @@ fn the_repair_loop_makes_one_correct_model_of_the_halls_two_orbits() {
 }
 
 /// The hall's loop again from the same matching, with COLMAP 4.2's global mapper
-/// (`MAPPER=global`, through pycolmap): the preset's selection ghosts there too (18 and 19 of
-/// 38 right in two runs), and one turn makes one model of 38, every camera right (session 30;
-/// fresh halls in docs/check.md). COLMAP 4 maps copies: the pipeline's databases stay COLMAP 3.8's,
+/// (`MAPPER=global`, through pycolmap), started from the first run's database
+/// (`DATABASE=work/full.db`, as a user starts from a database already matched): the preset's
+/// selection ghosts there too (18 and 19 of 38 right in two runs), and one turn makes one model
+/// of 38, every camera right (session 30; fresh halls in docs/check.md). The matched database
+/// is read, never written; COLMAP 4 maps copies: the pipeline's databases stay COLMAP 3.8's,
 /// unmigrated. About 20 s more.
 fn the_loop_with_colmap4s_global_mapper_repairs_the_hall_too(dir: &Path) {
-    let work = run_pipeline(dir, 3, "global");
+    let matched = dir.join("work/full.db");
+    let before = std::fs::read(&matched).unwrap();
+    let database = matched.to_str().unwrap();
+    let env = [
+        ("REPAIR", "3"),
+        ("MAPPER", "global"),
+        ("DATABASE", database),
+    ];
+    let work = run_pipeline(dir, "global", &env);
+    assert!(
+        std::fs::read(&matched).unwrap() == before,
+        "the matched database changed"
+    );
+    assert!(!work.join("extract.log").exists(), "matched again");
+    for table in ["images", "keypoints", "matches", "two_view_geometries"] {
+        assert_eq!(
+            crate::support::dump(&work.join("full.db"), table),
+            crate::support::dump(&matched, table),
+            "{table} copied"
+        );
+    }
     let log = std::fs::read_to_string(work.join("mapper_pruned.log")).unwrap();
     assert!(log.contains(r#""mapper": "global""#), "{log}");
     for db in ["full.db", "pruned.db"] {

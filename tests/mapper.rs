@@ -169,3 +169,49 @@ fn colmap_reads_the_ground_truth_model() {
     assert!(eval.max_position_error() < 1e-6 * eval.extent);
     assert!(eval.max_rotation_error_deg() < 1e-4);
 }
+
+/// `scripts/pipeline.sh` from a matched database (`DATABASE`) on which COLMAP 3.8 makes no
+/// model (8 images sharing 150 points: it keeps no initial pair, "failed to create sparse
+/// model"): an outcome, recorded, not a failure (a 28-image twin once stopped the pipeline
+/// there). Both runs are rows of no model, nothing is checked, the loop ends at once, and the
+/// matched database is read, never written. About a second.
+#[test]
+fn the_pipeline_records_a_run_with_no_model_and_leaves_the_matched_database_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let (db, gt) = (dir.path().join("matched.db"), dir.path().join("gt"));
+    let spec = SceneSpec {
+        num_images: 8,
+        num_points: 150,
+        seed: 2,
+        ..SceneSpec::default()
+    };
+    write_gt_model(&generate(&spec, &db).unwrap(), &gt).unwrap();
+    let before = std::fs::read(&db).unwrap();
+    let (images, work) = (dir.path().join("images"), dir.path().join("work"));
+    std::fs::create_dir_all(&images).unwrap();
+    let matched = db.to_str().unwrap();
+    let env = [("DATABASE", matched), ("REPAIR", "1")];
+    crate::support::pipeline_sh(&images, &work, &gt, &env);
+    assert!(
+        std::fs::read(&db).unwrap() == before,
+        "the matched database changed"
+    );
+    let read = |name: &str| std::fs::read_to_string(work.join(name)).unwrap();
+    assert!(read("mapper_full.log").contains("failed to create sparse model"));
+    let summary: serde_json::Value = serde_json::from_str(&read("summary.json")).unwrap();
+    for run in ["full", "pruned"] {
+        let row = &summary[run];
+        assert_eq!(
+            (&row["models"], &row["registered"]),
+            (&0.into(), &0.into()),
+            "{row}"
+        );
+        assert_eq!(row["check"], "-", "{run} checked");
+    }
+    assert!(summary.get("repaired1").is_none(), "{summary}");
+    assert_eq!(summary["loop_answer"], "pruned");
+    assert_eq!(
+        crate::support::dump(&work.join("full.db"), "two_view_geometries"),
+        crate::support::dump(&db, "two_view_geometries")
+    );
+}
