@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # `vgsel-colmap check` against the ground truth's verdict, per model: for each scene, full and
-# pruned databases through scripts/pipeline.sh (COLMAP 3.8's mapper; with GLOBAL=1 also COLMAP
-# 4.2's global mapper through pycolmap), every sub-model scored by `eval` (ground truth) and
-# checked by `check` (no ground truth). Prints one row per model and the threshold range over
-# which the check's verdict agrees with the truth on every row; writes WORK/check-scenes.json.
+# pruned databases through scripts/pipeline.sh (COLMAP 3.8's mapper; with GLOBAL=1 pipeline.sh
+# again from the same database with COLMAP 4.2's global mapper, into SCENE/global), every
+# sub-model scored by `eval` (ground truth) and checked by `check` (no ground truth). Prints one
+# row per model and the threshold range over which the check's verdict agrees with the truth on
+# every row; writes WORK/check-scenes.json.
 #
 # usage: scripts/lab/check-scenes.sh WORK [SCENE ...]
 #   SCENE  duplicate | twin | symmetric | room (rendered, 480x360, seed 1: 20 images, the twin
@@ -35,6 +36,7 @@ export VGSEL=$bin
 for scene in "${scenes[@]}"; do
   dir=$work/$scene
   [ "${CHECK_ONLY:-0}" = 1 ] && continue
+  prune_args=
   case $scene in
     duplicate | twin | symmetric | room)
       # As tests/e2e.rs and docs/priors.md render them: the twin needs 36 images to map at all.
@@ -42,7 +44,8 @@ for scene in "${scenes[@]}"; do
       [ -d "$dir/scene" ] || "$bin" generate images -q --scene "$scene" --num_images $n --seed 1 \
         --output "$dir/scene"
       images=$dir/scene/images gt=$dir/scene/gt
-      PRUNE_ARGS="--preset disambiguation" MAX_FEATURES=1024 CAMERA_PARAMS=400,240,180,0 \
+      prune_args="--preset disambiguation"
+      PRUNE_ARGS=$prune_args MAX_FEATURES=1024 CAMERA_PARAMS=400,240,180,0 \
         bash "$here/scripts/pipeline.sh" "$images" "$dir" "$gt" >"$dir.pipeline.log" 2>&1 ||
         echo "check-scenes: pipeline failed on $scene (see $dir.pipeline.log)" >&2 ;;
     *)
@@ -70,17 +73,13 @@ for scene in "${scenes[@]}"; do
       grep -q "^$variant: .*ghost-free" "$dir/topview.txt" && echo clean >"$dir/sparse_$variant.truth"
     done
   fi
-  if [ "${GLOBAL:-0}" = 1 ]; then
-    py=$(bash "$here/scripts/ci/pycolmap-venv.sh")
-    for variant in full pruned; do
-      out=$dir/global_$variant
-      if [ -f "$dir/$variant.db" ] && [ ! -d "$out" ]; then
-        # COLMAP 4 migrates a 3.8 database when it opens it: map a copy.
-        cp "$dir/$variant.db" "$dir/global_$variant.db"
-        nice "$py" "$here/scripts/ci/colmap4.py" map global "$dir/global_$variant.db" "$images" \
-          "$out" >"$out.json" 2>"$out.log" || echo "global mapper failed on $scene $variant" >&2
-      fi
-    done
+  if [ "${GLOBAL:-0}" = 1 ] && [ -f "$dir/full.db.done" ] && [ ! -f "$dir/global/summary.json" ]; then
+    # COLMAP 4.2's global mapper on the same matching: pipeline.sh again from this scene's
+    # database, with the same prune, into SCENE/global (COLMAP 4 maps copies; the databases
+    # stay COLMAP 3.8's).
+    env ${prune_args:+"PRUNE_ARGS=$prune_args"} DATABASE="$dir/full.db" MAPPER=global \
+      bash "$here/scripts/pipeline.sh" "$images" "$dir/global" "$gt" >"$dir.global.log" 2>&1 ||
+      echo "check-scenes: global mapper failed on $scene (see $dir.global.log)" >&2
   fi
   echo "check-scenes: $scene done" >&2
 done
@@ -91,9 +90,9 @@ rows=$work/rows.tsv
 for scene in "${scenes[@]}"; do
   dir=$work/$scene
   gt=$(cat "$dir/gt.path")
-  for run in sparse_full sparse_pruned global_full global_pruned; do
+  for run in sparse_full sparse_pruned global/sparse_full global/sparse_pruned; do
     [ -d "$dir/$run" ] || continue
-    db=$dir/${run#*_}.db
+    db=$dir/$(dirname "$run")/${run##*sparse_}.db
     for model in $(ls -d "$dir/$run"/*/ 2>/dev/null | sort); do
       model=${model%/}
       [ -e "$model/images.bin" ] || [ -e "$model/images.txt" ] || continue

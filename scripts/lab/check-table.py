@@ -55,13 +55,13 @@ def main():
             # The score a threshold is compared with (0 where too few conflicts for any).
             "effective": m["score"] if enough else 0.0,
         })
-    print(f"{'scene':<24} {'model':<18} {'reg':>4} {'wrong':>5} {'truth':>8} {'check':>8} "
+    print(f"{'scene':<24} {'model':<22} {'reg':>4} {'wrong':>5} {'truth':>8} {'check':>8} "
           f"{'score':>6} {'confl.':>7} {'judged':>7}")
     verdict = {True: "ghosted", False: "clean", None: "?"}
     for r in rows:
         mark = "" if r["truth"] in (r["check"], None) else "  <- disagrees"
         wrong = "-" if r["wrong"] is None else r["wrong"]
-        print(f"{r['scene']:<24} {r['model']:<18} {r['registered']:>4} {wrong:>5} "
+        print(f"{r['scene']:<24} {r['model']:<22} {r['registered']:>4} {wrong:>5} "
               f"{verdict[r['truth']]:>8} {verdict[r['check']]:>8} "
               f"{r['score']:>6.3f} {r['conflicting']:>7} {r['judged']:>7}{mark}")
     clean = [r["effective"] for r in rows if r["truth"] is False]

@@ -7,8 +7,8 @@ Three kinds of work folder, as the lab scripts leave them:
   --loops DIR ...   scripts/lab/repair-loop.sh's: every run of each loop (the full, pruned and
                     repaired models, each with its database and eval); truth: every registered
                     camera correct
-  --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned, global_full,
-                    global_pruned per scene with their databases; truth: SUB.eval.json's, per
+  --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned and (GLOBAL=1)
+                    global/sparse_full, global/sparse_pruned per scene with their databases; truth: SUB.eval.json's, per
                     sub-model, "unknown" without ground truth
   --peers WORK      scripts/bench/disambiguation_peers.py's: its runs' truth (the judged frames)
 
@@ -45,8 +45,8 @@ def models(args):
         for scene in sorted(glob.glob(f"{work}/*/full.db")):
             d = os.path.dirname(scene)
             for folder, db in (("sparse_full", "full.db"), ("sparse_pruned", "pruned.db"),
-                               ("global_full", "global_full.db"),
-                               ("global_pruned", "global_pruned.db")):
+                               ("global/sparse_full", "global/full.db"),
+                               ("global/sparse_pruned", "global/pruned.db")):
                 subs = glob.glob(f"{d}/{folder}/[0-9]*")
                 for sub in sorted(s for s in subs if os.path.basename(s).isdigit()):
                     ev = sub + ".eval.json"
