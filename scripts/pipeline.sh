@@ -23,7 +23,8 @@
 #                   [colmap3.8]
 #   MAPPER          colmap3.8 (`colmap mapper`), or COLMAP 4.2's incremental or global mapper
 #                   (each run on a copy of its database, which COLMAP 4 would migrate) [colmap3.8]
-#   VGSEL           the vgsel-colmap binary [target/release/vgsel-colmap, built if missing]
+#   VGSEL           the vgsel-colmap binary [in a checkout target/release/vgsel-colmap, built if
+#                   missing; installed, vgsel-colmap on PATH]
 #   REPAIR          N > 0: the repair loop (docs/check.md), at most N turns: `vgsel-colmap
 #                   check` on the last model, and where its report's `repair` is not empty
 #                   (a ghost's pairs to blame, or pairs that place a misplaced group, join
@@ -43,14 +44,22 @@
 #                   loop_answer) is its last run the check calls clean, else its last run
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
-here=$(cd "$(dirname "$0")/.." && pwd)
+# This checkout, or the package's copy of its scripts (/usr/share/vgsel-colmap, run as
+# vgsel-colmap-pipeline).
+here=$(cd "$(dirname "$(readlink -f "$0")")/.." && pwd)
 images=$(cd "$1" && pwd)
 mkdir -p "$2"
 work=$(cd "$2" && pwd)
 gt=${3:+$(cd "$3" && pwd)}
 prune_args=${PRUNE_ARGS---min_image_fraction 1 --min_pairs_per_image 5}
-bin=${VGSEL:-$here/target/release/vgsel-colmap}
-[ -x "$bin" ] || (cd "$here" && cargo build --release --quiet)
+if [ -n "${VGSEL:-}" ]; then
+  bin=$VGSEL
+elif [ -f "$here/Cargo.toml" ]; then
+  bin=$here/target/release/vgsel-colmap
+  [ -x "$bin" ] || (cd "$here" && cargo build --release --quiet)
+else
+  bin=$(command -v vgsel-colmap) || { echo "pipeline: vgsel-colmap is not on PATH" >&2; exit 2; }
+fi
 log() { echo "pipeline: $*" >&2; }
 matcher=${MATCHER:-colmap3.8} mapper=${MAPPER:-colmap3.8}
 case "$matcher/$mapper" in
