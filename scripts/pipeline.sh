@@ -87,6 +87,7 @@ timed() {
 if [ ! -f "$work/full.db.done" ]; then
   rm -f "$work/full.db"
   if [ -n "${DATABASE:-}" ]; then
+    [ -f "$DATABASE" ] || { echo "pipeline: DATABASE $DATABASE: no such file" >&2; exit 2; }
     log "the matched database $DATABASE, copied"
     # SQLite's backup, opened read-only: a copy whole even where the source has a -wal file.
     python3 -c 'import sqlite3, sys
