@@ -147,9 +147,9 @@ fn pipeline(kind: SceneKind, num_images: usize, repair: u32) -> (tempfile::TempD
     (dir, work)
 }
 
-/// `scripts/pipeline.sh` on the scene written in `dir` (its images and gt), into `dir/work`,
+/// `scripts/pipeline.sh` on the scene written in `dir` (its images and gt), into `dir/{work}`,
 /// with `--preset disambiguation`, 1024 SIFT features, the renderer's intrinsics and `env`
-/// (REPAIR, MAPPER, DATABASE, ...) on top.
+/// (REPAIR, MAPPER, DATABASE, ...) on top; a matching already in that folder is reused.
 fn run_pipeline(dir: &Path, work: &str, env: &[(&str, &str)]) -> PathBuf {
     let work = dir.join(work);
     crate::support::pipeline_sh(&dir.join("images"), &work, &dir.join("gt"), env);
