@@ -42,7 +42,7 @@
 #                   seconds (README); a run whose mapper makes no model (COLMAP 3.8 found no
 #                   initial pair: an outcome, recorded as such) ends the loop, the model
 #                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
-#                   loop_answer) is its last run the check calls clean, else the pruned run
+#                   loop_answer) is its last run the check calls clean, else its last run
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 # This checkout, or the package's copy of its scripts (/usr/share/vgsel-colmap, run as
@@ -246,17 +246,11 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
 done
 # The loop's answer: its last run the check calls clean, where a later turn's run is not (the
 # pieces a clean run's join or placement kept, made a ghost by the next mapper run: streets 128
-# and 147 of docs/check.md, 44 and 29 of 44 right against 23 and 19). Where no run is clean,
-# the preset's run: turns the check never confirmed are not taken (in every such loop measured
-# the last run was no better than the first: docs/check.md, "The loop's answer").
+# and 147 of docs/check.md, 44 and 29 of 44 right against 23 and 19); else its last run.
 if [ "${REPAIR:-0}" -gt 0 ]; then
-  if [ -z "$answer" ]; then
-    answer=pruned
-    [ "$last" = pruned ] ||
-      log "no run is clean: the loop's answer is the preset's run, sparse_pruned (flagged)"
-  elif [ "$answer" != "$last" ]; then
+  [ -n "$answer" ] || answer=$last
+  [ "$answer" = "$last" ] ||
     log "the $last model is not clean and the $answer model is: the loop's answer is sparse_$answer"
-  fi
   echo "$answer" >"$work/answer"
 fi
 

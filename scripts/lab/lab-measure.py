@@ -25,7 +25,7 @@ usage: scripts/lab/lab-measure.py NAME IMAGES WORK ORDER.db [VARIANT=DB ...] [--
             scripts/pipeline.sh's repair loop (REPAIR=3, the `disambiguation` preset with the
             run's order and options, the run's mapper) on a copy of the variant's database, in
             WORK/loop_TAG; the record is the loop's answer, its last run `check` calls clean,
-            else the preset's (`last`: the last run; `turns`: the turns taken));
+            else its last (`last`: the last run; `turns`: the turns taken));
             --order, default image_id; mapper colmap3.8
             (`colmap mapper`, the default) or global (COLMAP 4.2's); more prune options, split
             at spaces). results.json names each run's model folder (`sparse`).

@@ -1,10 +1,9 @@
 #!/usr/bin/env python3
 """The repair loop's answer against its last run, over scripts/lab/repair-loop.sh's loop.json
 files: the loops whose answer (scripts/pipeline.sh's: its last run the check calls clean, else
-the preset's run) is an earlier run, and the correct cameras summed both ways. A clean run's turn
-(pieces joined, lost images placed) can end in a ghost that the loop has no turn left to repair;
-the clean run before it is the better answer; where no run is clean, the turns' runs were no
-better than the preset's in every loop measured (docs/check.md, "The loop's answer").
+its last run with a model) is an earlier run, and the correct cameras summed both ways. A clean
+run's turn (pieces joined, lost images placed) can end in a ghost that the loop has no turn left
+to repair; the clean run before it is the better answer (docs/check.md, "The loop's answer").
 
 usage: scripts/lab/loop_answer.py LOOP_JSON...
 Prints the loops whose answer is not their last run, then the totals."""
