@@ -8,8 +8,8 @@ Three kinds of work folder, as the lab scripts leave them:
                     repaired models, each with its database and eval); truth: every registered
                     camera correct
   --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned and (GLOBAL=1)
-                    global/sparse_full, global/sparse_pruned per scene with their databases; truth: SUB.eval.json's, per
-                    sub-model, "unknown" without ground truth
+                    global/sparse_full, global/sparse_pruned per scene with their databases;
+                    truth: SUB.eval.json's, per sub-model, "unknown" without ground truth
   --peers WORK      scripts/bench/disambiguation_peers.py's: its runs' truth (the judged frames)
 
 Prints one row per model folder (set, truth, exit status, verdict lines), then per set the
