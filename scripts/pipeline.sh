@@ -13,8 +13,8 @@
 #            present (delete WORKDIR to start again); the prune and its mapper always run
 #   GT       ground-truth COLMAP model (text or binary); images are matched by name
 # environment (defaults in brackets):
-#   PRUNE_ARGS      extra `vgsel-colmap prune` options [--min_image_fraction 1 --min_pairs_per_image 5;
-#                   with REPAIR, the loop's preset: --preset disambiguation]
+#   PRUNE_ARGS      extra `vgsel-colmap prune` options [none: prune's defaults; with REPAIR, the
+#                   loop's preset: --preset disambiguation]
 #   MAX_IMAGE_SIZE  SIFT image size [1024]       MAX_FEATURES  SIFT features per image [2048]
 #   CAMERA_MODEL    [SIMPLE_RADIAL]              CAMERA_PARAMS known intrinsics, e.g. "f,cx,cy" []
 #   SINGLE_CAMERA   one camera for all images [1]
@@ -60,7 +60,8 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
   [[ $prune_args == *disambiguation* ]] || echo "pipeline: warning: REPAIR without a" \
     "disambiguation preset in PRUNE_ARGS: the loop is measured with --preset disambiguation" >&2
 else
-  prune_args=${PRUNE_ARGS---min_image_fraction 1 --min_pairs_per_image 5}
+  # prune's own defaults, as a user's `vgsel-colmap prune` gets them.
+  prune_args=${PRUNE_ARGS-}
 fi
 if [ -n "${VGSEL:-}" ]; then
   bin=$VGSEL

@@ -144,6 +144,20 @@ pub struct CostModel {
     /// Any negative-cost arc lets a flow path run on from one copy of a duplicated structure to
     /// the other, so without a floor the flow keeps false pairs that rank low (docs/priors.md).
     pub min_pair_fitness: f64,
+    /// Pairs whose `backbone_tracks` fitness (with [`Trapezoid::FRACTION`], its share: the
+    /// inliers that chains of matches through the images' strongest pairs also join) is below
+    /// this are left out of the network whatever their cost; 0 is off. The model must list
+    /// that prior (at weight 0 where it only gates). The rest of the view graph does not corroborate such a pair: on
+    /// repeated structure (castle, lego) the false pairs are nearly all of them, and one kept
+    /// false pair turned a group of castle's cameras 14 degrees in COLMAP 4.2's global mapper
+    /// (docs/priors.md). Recorded runs from before it load with 0, as they ran.
+    #[serde(default, skip_serializing_if = "is_off")]
+    pub min_backbone_tracks: f64,
+}
+
+/// A gate of 0 is not written, so that a record of a run without one reads as before it existed.
+fn is_off(gate: &f64) -> bool {
+    *gate == 0.0
 }
 
 impl CostModel {
@@ -168,13 +182,17 @@ impl CostModel {
         Ok(())
     }
 
-    /// The pair priors to compute: those with a weight, or all of them.
+    /// The pair priors to compute: those with a weight, or all of them, and `backbone_tracks`
+    /// where the gate reads it.
     pub fn pair_priors_to_compute(&self, unweighted: bool) -> Vec<Prior> {
-        self.pair_priors
-            .iter()
+        let mut priors: Vec<Prior> = (self.pair_priors.iter())
             .filter(|p| unweighted || p.weight > 0.0)
             .map(|p| p.prior)
-            .collect()
+            .collect();
+        if self.min_backbone_tracks > 0.0 && !priors.contains(&Prior::BackboneTracks) {
+            priors.push(Prior::BackboneTracks);
+        }
+        priors
     }
 }
 
@@ -299,6 +317,7 @@ mod tests {
                 .to_vec(),
             node_constant: 1.0,
             min_pair_fitness: 0.0,
+            min_backbone_tracks: 0.0,
         };
         model.set_weight("overlap", 3.0).unwrap();
         assert!(model.set_weight("nope", 1.0).is_err());
@@ -346,6 +365,7 @@ mod tests {
             ],
             node_constant: 0.0,
             min_pair_fitness: 0.0,
+            min_backbone_tracks: 0.0,
         };
         let pairs = [
             PriorValues {

@@ -54,8 +54,12 @@ fn row(preset: Preset, d: &Defaults) -> String {
         true => "off".to_string(),
         false => completion.join("; "),
     };
+    let gate = match model.min_backbone_tracks {
+        0.0 => "off".to_string(),
+        gate => format!("below {gate}"),
+    };
     format!(
-        "| {} | {priors} | {images} | {} | {} | {completion} |\n",
+        "| {} | {priors} | {images} | {} | {} | {gate} | {completion} |\n",
         preset.name(),
         search.join(", "),
         model.min_pair_fitness
@@ -64,8 +68,8 @@ fn row(preset: Preset, d: &Defaults) -> String {
 
 fn table() -> String {
     let mut table = String::from(
-        "| preset | pair priors (weight) | image costs | search | fitness floor | track completion |\n\
-         |---|---|---|---|---|---|\n",
+        "| preset | pair priors (weight) | image costs | search | fitness floor | backbone_tracks gate | track completion |\n\
+         |---|---|---|---|---|---|---|\n",
     );
     for &preset in Preset::ALL {
         table += &row(preset, &preset.defaults());

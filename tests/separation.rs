@@ -1,5 +1,6 @@
 //! Separation of true and false pairs on the generated duplicate-structure scene: each pair
-//! prior's AUC against the ground-truth labels, and what `--preset disambiguation` removes.
+//! prior's AUC against the ground-truth labels, what `--preset disambiguation` removes, and the
+//! general preset's backbone-tracks gate.
 //! `cargo test --test separation -- --nocapture` prints the table; the ignored test runs a
 //! bigger scene (`cargo test --release --test separation -- --ignored --nocapture`).
 
@@ -85,4 +86,41 @@ fn bigger_duplicate_scenes() {
         eprintln!("== 80 images, 12000 points, yaw {yaw}");
         run(&duplicate(80, 12000, yaw));
     }
+}
+
+/// The general preset's backbone-tracks gate (`--min_backbone_tracks`): on the duplicate scene
+/// the general selection keeps false pairs without it and far fewer with it, and the gate
+/// leaves no image without a pair nor the true pairs kept in pieces.
+#[test]
+fn the_general_presets_gate_keeps_uncorroborated_pairs_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("duplicate.db");
+    let gt = generate(&duplicate(36, 5000, 0.0), &path).unwrap();
+    let db = Database::open_read_only(&path).unwrap();
+    let general = |gate: f64| {
+        let mut parameters = Parameters::of_preset(Preset::General);
+        parameters.cost_model.min_backbone_tracks = gate;
+        let p = plan(
+            &db,
+            &parameters,
+            &Overrides::default(),
+            Extras::default(),
+            &|_| {},
+        );
+        measure(&p.unwrap(), &gt)
+    };
+    let (open, gated) = (general(0.0), general(0.1));
+    let kept = |s: &Separation| ((1.0 - s.false_removed) * s.false_pairs as f64).round();
+    eprintln!(
+        "false pairs kept: without the gate {}, with it {}",
+        kept(&open),
+        kept(&gated)
+    );
+    assert!(
+        kept(&open) >= 5.0,
+        "the scene must tempt the general preset"
+    );
+    assert!(kept(&gated) <= 1.0);
+    assert_eq!(gated.images_without_pair, 0);
+    assert_eq!(gated.true_components, 1);
 }

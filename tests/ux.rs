@@ -357,8 +357,12 @@ fn the_capture_order_is_reported_and_exif_needs_the_images() {
         assert!(err.contains(needle) && err.lines().count() == 1, "{err}");
         assert_eq!(std::fs::read(&db).unwrap(), before);
     };
-    // Only the backbone_tracks prior reads the sequence: a preset without it is told so.
-    fails_with(&["--sequence_window", "2"], "backbone_tracks");
+    // Only the backbone_tracks prior reads the sequence: where nothing reads it (the general
+    // preset with its gate off) the user is told so.
+    fails_with(
+        &["--sequence_window", "2", "--min_backbone_tracks", "0"],
+        "backbone_tracks",
+    );
     for r in [&by_id, &by_graph] {
         let share = r["order"]["selected_within_window"].as_f64().unwrap();
         assert!((0.0..=1.0).contains(&share));

@@ -84,7 +84,7 @@ pub fn preset_defaults(command: clap::Command) -> clap::Command {
 type Field = fn(&Defaults) -> String;
 
 /// Each option whose default the preset decides, and where the table holds it.
-const PRESET_DEFAULTS: [(&str, Field); 9] = [
+const PRESET_DEFAULTS: [(&str, Field); 10] = [
     ("min_image_fraction", |d| {
         d.criteria.min_image_fraction.to_string()
     }),
@@ -107,6 +107,9 @@ const PRESET_DEFAULTS: [(&str, Field); 9] = [
     ("biconnected", |d| d.biconnected.to_string()),
     ("min_pair_fitness", |d| {
         d.cost_model.min_pair_fitness.to_string()
+    }),
+    ("min_backbone_tracks", |d| {
+        d.cost_model.min_backbone_tracks.to_string()
     }),
 ];
 

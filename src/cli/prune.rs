@@ -129,6 +129,12 @@ pub struct PruneArgs {
     /// by --model).
     #[arg(long, value_parser = fraction, help_heading = EXPERT)]
     min_pair_fitness: Option<f64>,
+    /// Pairs whose backbone_tracks share (of their inliers, those that chains of matches
+    /// through the images' strongest pairs also join) is below this are never selected: the
+    /// rest of the view graph does not corroborate them, as with false pairs between repeated
+    /// structures. 0 turns the gate off.
+    #[arg(long, value_parser = fraction, help_heading = EXPERT)]
+    min_backbone_tracks: Option<f64>,
 }
 
 impl PruneArgs {
@@ -143,6 +149,7 @@ impl PruneArgs {
             biconnected: self.biconnected,
             weights: self.weights.0.clone(),
             min_pair_fitness: self.min_pair_fitness,
+            min_backbone_tracks: self.min_backbone_tracks,
             order: Some(self.order),
             image_path: self.image_path.clone(),
             sequence_window: Some(self.sequence_window),

@@ -60,6 +60,11 @@ pub struct Report {
     pub fitness_floor: f64,
     /// Edges never offered to the flow: fitness below `fitness_floor`.
     pub pairs_below_fitness_floor: usize,
+    /// The cost model's `min_backbone_tracks` (0: no gate).
+    pub min_backbone_tracks: f64,
+    /// Edges never offered to the flow: their `backbone_tracks` share below
+    /// `min_backbone_tracks` (the view graph does not corroborate them).
+    pub pairs_below_backbone_tracks: usize,
     /// The view graph before the prune.
     pub graph_before: GraphStats,
     /// The graph of the selected pairs; its `isolated_images` counts every image left without one.
@@ -166,6 +171,8 @@ impl Report {
             matches_dropped: matches_dropped(plan),
             fitness_floor: plan.fitness_floor,
             pairs_below_fitness_floor: plan.below_fitness_floor,
+            min_backbone_tracks: parameters.cost_model.min_backbone_tracks,
+            pairs_below_backbone_tracks: plan.below_backbone_tracks,
             graph_before: plan.graph.stats(),
             graph_after: after.stats(),
             criteria: plan.search.criteria.clone(),

@@ -4,14 +4,15 @@
 //! are removed, and the pairs that link clean models placed in one frame are kept, whatever an
 //! earlier model blamed; see [`crate::check::loop_evidence`]), the user's overrides
 //! (`--forbid_images`, `--forbid_pairs`, which win over the models', then `--keep_pairs`),
-//! close neighbours in a capture sequence (`--keep_neighbours`), and the fitness floor
-//! (`--min_pair_fitness`, lowered as far as the search needs).
+//! close neighbours in a capture sequence (`--keep_neighbours`), the pairs the view graph does
+//! not corroborate (`--min_backbone_tracks`), and the fitness floor (`--min_pair_fitness`,
+//! lowered as far as the search needs).
 //!
 //! Rules change the network ([`crate::flow::network::SelectionProblem::restrict`]), never
 //! the costs, so the result stays an exact min-cost flow and is easy to explain:
 //! - a forbidden image leaves the network with all its pairs; the search criteria count only the
 //!   images that remain;
-//! - a forbidden pair's arc, or one below the floor, leaves the network;
+//! - a forbidden pair's arc, or one below the gate or the floor, leaves the network;
 //! - a kept pair's arc leaves the network too, and the pair (with both its images) is added to
 //!   whatever the flow selects. The flow optimises the rest of the graph: the criteria and the
 //!   selection curve describe the flow's part, before the kept pairs are added.
@@ -401,11 +402,16 @@ pub fn keep_neighbours(
     kept
 }
 
-/// Removes every free edge whose fitness (−cost) is below `floor`. Returns how many.
-pub fn remove_below_floor(rules: &mut [ArcRule], pair_costs: &[f64], floor: f64) -> usize {
+/// Removes every free edge whose value (a fitness, −cost, or a prior's raw value) is below
+/// `min`. Returns how many.
+pub fn remove_below(
+    rules: &mut [ArcRule],
+    values: impl IntoIterator<Item = f64>,
+    min: f64,
+) -> usize {
     let mut removed = 0;
-    for (rule, cost) in rules.iter_mut().zip(pair_costs) {
-        if *rule == ArcRule::Free && -cost < floor {
+    for (rule, value) in rules.iter_mut().zip(values) {
+        if *rule == ArcRule::Free && value < min {
             *rule = ArcRule::Removed;
             removed += 1;
         }

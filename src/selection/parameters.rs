@@ -47,6 +47,8 @@ pub struct Given {
     pub weights: Vec<(String, f64)>,
     /// `--min_pair_fitness` (the preset's).
     pub min_pair_fitness: Option<f64>,
+    /// `--min_backbone_tracks` (the preset's).
+    pub min_backbone_tracks: Option<f64>,
     /// `--order` (image_id).
     pub order: Option<Order>,
     /// `--image_path`, for the exif order.
@@ -126,6 +128,9 @@ impl Parameters {
         if let Some(floor) = given.min_pair_fitness {
             cost_model.min_pair_fitness = floor;
         }
+        if let Some(gate) = given.min_backbone_tracks {
+            cost_model.min_backbone_tracks = gate;
+        }
         let sequence_window = given.sequence_window.unwrap_or(0);
         if sequence_window > 0
             && !cost_model
@@ -133,7 +138,7 @@ impl Parameters {
                 .contains(&Prior::BackboneTracks)
         {
             bail!(
-                "--sequence_window shapes the backbone_tracks prior, which --preset {} does not weigh (use --preset disambiguation, or give it a weight with --weights)",
+                "--sequence_window shapes the backbone_tracks prior, which --preset {} does not read here (use --preset disambiguation, a weight with --weights, or --min_backbone_tracks)",
                 preset.name()
             );
         }
@@ -409,7 +414,11 @@ mod tests {
         };
         assert_eq!(oldest.flow, Flow::Searched(expected));
         assert_eq!(oldest.capture, capture_order::Input::default());
-        assert_eq!(oldest.cost_model, Preset::General.defaults().cost_model);
+        // Runs from before the backbone-tracks gate ran without it and the prior it reads.
+        let mut general = Preset::General.defaults().cost_model;
+        general.pair_priors.retain(|p| p.prior != Prior::BackboneTracks);
+        general.min_backbone_tracks = 0.0;
+        assert_eq!(oldest.cost_model, general);
     }
 
     /// `model` was one folder's string before `--model` could be repeated: such a record loads
@@ -460,11 +469,15 @@ mod tests {
             ..Given::default()
         };
         assert!(Parameters::resolve(unknown).is_err());
-        let window_without_backbone = Given {
+        // The general preset reads backbone_tracks for its gate, which a window shapes; with
+        // the gate off nothing reads it.
+        let window = |gate| Given {
             sequence_window: Some(3),
+            min_backbone_tracks: gate,
             ..Given::default()
         };
-        let error = Parameters::resolve(window_without_backbone).unwrap_err();
+        assert!(Parameters::resolve(window(None)).is_ok());
+        let error = Parameters::resolve(window(Some(0.0))).unwrap_err();
         assert!(error.to_string().contains("--preset general"), "{error}");
     }
 }

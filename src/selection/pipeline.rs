@@ -86,6 +86,9 @@ pub struct Plan {
     pub fitness_floor: f64,
     /// Free edges (neither kept nor forbidden) below `fitness_floor`, taken out of the network.
     pub below_fitness_floor: usize,
+    /// Free edges whose `backbone_tracks` share is below the cost model's
+    /// `min_backbone_tracks`, taken out of the network before the floor.
+    pub below_backbone_tracks: usize,
     /// What the write does: the view-graph edges the selection leaves out are invalidated.
     pub edits: Edits,
     /// Seconds per stage, for the report.
@@ -150,7 +153,7 @@ pub fn plan(
     let costs = costs::compute(&parameters.cost_model, &image_priors, &pair_priors.values);
     timings.priors = t.elapsed().as_secs_f64();
 
-    // 4. Arc rules: close neighbours kept, pairs below the fitness floor removed.
+    // 4. Arc rules: close neighbours kept, pairs below the gate and the fitness floor removed.
     stage("solving the min-cost flow selection");
     let t = Instant::now();
     let ruled = apply_arc_rules(parameters, &rules, &graph, &costs, &order);
@@ -185,6 +188,7 @@ pub fn plan(
         completion,
         fitness_floor: ruled.fitness_floor,
         below_fitness_floor: ruled.below_fitness_floor,
+        below_backbone_tracks: ruled.below_backbone_tracks,
         edits,
         timings,
         data_version,
@@ -264,10 +268,12 @@ struct Ruled {
     neighbours_kept: usize,
     fitness_floor: f64,
     below_fitness_floor: usize,
+    below_backbone_tracks: usize,
 }
 
-/// Stage 4: to the overrides' rules, adds the close neighbours kept and the pairs below the
-/// fitness floor, and restricts the paper's network by them.
+/// Stage 4: to the overrides' rules, adds the close neighbours kept, the pairs below the
+/// backbone-tracks gate and those below the fitness floor, and restricts the paper's network by
+/// them.
 fn apply_arc_rules(
     parameters: &Parameters,
     overrides: &Resolved,
@@ -278,10 +284,25 @@ fn apply_arc_rules(
     let mut edges = overrides.edges.clone();
     let window = parameters.arc_rules.keep_neighbours;
     let neighbours_kept = arc_rules::keep_neighbours(&mut edges, graph, order, window);
-    let floor = parameters.cost_model.min_pair_fitness;
+    let model = &parameters.cost_model;
+    let gate = model.min_backbone_tracks;
+    let share = (costs.pair_fitness.iter()).find(|p| p.prior == Prior::BackboneTracks);
+    let below_backbone_tracks = match share {
+        Some(share) if gate > 0.0 => {
+            arc_rules::remove_below(&mut edges, share.values.iter().copied(), gate)
+        }
+        _ => 0,
+    };
     let rule = parameters.flow.rule();
-    let floor = arc_rules::fitness_floor(floor, &rule, graph, &edges, &costs.pair_costs);
-    let below_fitness_floor = arc_rules::remove_below_floor(&mut edges, &costs.pair_costs, floor);
+    let fitness = || costs.pair_costs.iter().map(|c| -c);
+    let floor = arc_rules::fitness_floor(
+        model.min_pair_fitness,
+        &rule,
+        graph,
+        &edges,
+        &costs.pair_costs,
+    );
+    let below_fitness_floor = arc_rules::remove_below(&mut edges, fitness(), floor);
     let network = problem(graph, costs, order)
         .restrict(&order.by_rank(&overrides.forbidden_vertices), &edges);
     Ruled {
@@ -289,6 +310,7 @@ fn apply_arc_rules(
         neighbours_kept,
         fitness_floor: floor,
         below_fitness_floor,
+        below_backbone_tracks,
     }
 }
 
