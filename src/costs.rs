@@ -147,10 +147,10 @@ pub struct CostModel {
     /// Pairs whose `backbone_tracks` fitness (with [`Trapezoid::FRACTION`], its share: the
     /// inliers that chains of matches through the images' strongest pairs also join) is below
     /// this are left out of the network whatever their cost; 0 is off. The model must list
-    /// that prior (at weight 0 where it only gates). The rest of the view graph does not corroborate such a pair: on
-    /// repeated structure (castle, lego) the false pairs are nearly all of them, and one kept
-    /// false pair turned a group of castle's cameras 14 degrees in COLMAP 4.2's global mapper
-    /// (docs/priors.md). Recorded runs from before it load with 0, as they ran.
+    /// that prior (at weight 0 where it only gates). The rest of the view graph does not
+    /// corroborate such a pair: on repeated structure (castle, lego) the false pairs are nearly
+    /// all of them, but so are a dense scene's weak long-range true pairs (docs/priors.md).
+    /// Recorded runs from before it load with 0, as they ran.
     #[serde(default, skip_serializing_if = "is_off")]
     pub min_backbone_tracks: f64,
 }

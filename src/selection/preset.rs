@@ -43,7 +43,7 @@ impl Named for Preset {
     // `prune --help` shows beside each option.
     fn help(self) -> &'static str {
         match self {
-            Preset::General => "Speed on ordinary scenes: image priors degree, track fraction, clustering; pair priors inliers, triangulation angle, overlap, infinite homography; pairs the rest of the view graph does not corroborate (backbone tracks below a gate, as false pairs between repeated facades) never selected; the search keeps most images, then the track completion adds the pairs the images need to stay registrable and accurate",
+            Preset::General => "Speed on ordinary scenes: image priors degree, track fraction, clustering; pair priors inliers, triangulation angle, overlap, infinite homography; the search keeps most images, then the track completion adds the pairs the images need to stay registrable and accurate",
             Preset::Disambiguation => "Scenes with duplicate or symmetric structure, whatever the image order: pair prior backbone tracks (the share of a pair's inliers that tracks through each image's strongest pairs join), pairs below a fitness floor never selected; the paper's context, loop and multiple motions, loop fraction and unique tracks at weight 0 (in --scores)",
             Preset::PaperDisambiguation => "The paper's section 5.1 as written, for comparison: context similarity, loop consistency and multiple motions with uniform weights, no fitness floor, the paper's share of pairs; relies on the pair arcs following the capture order (--order)",
         }
@@ -91,17 +91,17 @@ fn general() -> Defaults {
                 ),
                 PriorModel::new(Prior::Overlap, Trapezoid::OVERLAP, 1.0),
                 PriorModel::new(Prior::Homography, Trapezoid::HOMOGRAPHY, 1.0),
-                // Gates only (`min_backbone_tracks`); its fitness is its share.
+                // For `--min_backbone_tracks` and `--scores`; its fitness is its share.
                 PriorModel::new(Prior::BackboneTracks, Trapezoid::FRACTION, 0.0),
             ],
             node_constant: 1.0,
             min_pair_fitness: 0.0,
-            // Chosen on castle (one matching): its 106 false pairs (repeated facades) all but
-            // one below 0.1, 41 of its 234 true ones; the general selection kept one false pair
-            // and COLMAP 4.2's global mapper turned ten cameras 14 degrees in 3 of 4 runs (30 of
-            // 30 in every run with the gate). No pair of fountain or Herz-Jesus is below it;
-            // lego's 26 false pairs kept go (docs/priors.md).
-            min_backbone_tracks: 0.1,
+            // Off: 0.1 repaired castle with COLMAP 4.2's global mapper (its one false pair
+            // kept turned ten cameras 14 degrees in 4 of 8 runs; 30 of 30 in 12 of 12 gated)
+            // and lego's (94 -> 100 of 100), but took 1,524 of the rendered room100's 3,494
+            // pairs, all true, and tripled its position errors with both mappers
+            // (docs/priors.md). For repeated structure: --min_backbone_tracks 0.1.
+            min_backbone_tracks: 0.0,
         },
         criteria: criteria(0.9, 0.0, 0.0),
         completion: Needs {
