@@ -414,11 +414,12 @@ mod tests {
         };
         assert_eq!(oldest.flow, Flow::Searched(expected));
         assert_eq!(oldest.capture, capture_order::Input::default());
-        // Runs from before the backbone-tracks gate did not list the prior it reads.
+        // Runs from before the backbone-tracks gate ran without it and the prior it reads.
         let mut general = Preset::General.defaults().cost_model;
         general
             .pair_priors
             .retain(|p| p.prior != Prior::BackboneTracks);
+        general.min_backbone_tracks = 0.0;
         assert_eq!(oldest.cost_model, general);
     }
 
@@ -471,14 +472,14 @@ mod tests {
         };
         assert!(Parameters::resolve(unknown).is_err());
         // The general preset reads backbone_tracks only for its gate, which a window shapes;
-        // with the gate off (its default) nothing reads it.
+        // with the gate off nothing reads it.
         let window = |gate| Given {
             sequence_window: Some(3),
             min_backbone_tracks: gate,
             ..Given::default()
         };
-        assert!(Parameters::resolve(window(Some(0.1))).is_ok());
-        let error = Parameters::resolve(window(None)).unwrap_err();
+        assert!(Parameters::resolve(window(None)).is_ok());
+        let error = Parameters::resolve(window(Some(0.0))).unwrap_err();
         assert!(error.to_string().contains("--preset general"), "{error}");
     }
 }

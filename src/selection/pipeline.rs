@@ -165,7 +165,7 @@ pub fn plan(
         extras.curve_factor,
         &order,
     );
-    let completion = complete_tracks(&scene, &ruled.network, &mut search, &parameters.flow, stage);
+    let completion = complete_tracks(&scene, &ruled, &mut search, &parameters.flow, stage);
     timings.solve = t.elapsed().as_secs_f64();
 
     // 7. The edits: pairs left out invalidated, kept ones trimmed of what `--model` drops.
@@ -269,6 +269,8 @@ struct Ruled {
     fitness_floor: f64,
     below_fitness_floor: usize,
     below_backbone_tracks: usize,
+    /// Per view-graph edge: taken out by the backbone-tracks gate.
+    gated: Vec<bool>,
 }
 
 /// Stage 4: to the overrides' rules, adds the close neighbours kept, the pairs below the
@@ -287,12 +289,14 @@ fn apply_arc_rules(
     let model = &parameters.cost_model;
     let gate = model.min_backbone_tracks;
     let share = (costs.pair_fitness.iter()).find(|p| p.prior == Prior::BackboneTracks);
+    let before = edges.clone();
     let below_backbone_tracks = match share {
         Some(share) if gate > 0.0 => {
             arc_rules::remove_below(&mut edges, share.values.iter().copied(), gate)
         }
         _ => 0,
     };
+    let gated = before.iter().zip(&edges).map(|(a, b)| a != b).collect();
     let rule = parameters.flow.rule();
     let fitness = || costs.pair_costs.iter().map(|c| -c);
     let floor = arc_rules::fitness_floor(
@@ -311,6 +315,7 @@ fn apply_arc_rules(
         fitness_floor: floor,
         below_fitness_floor,
         below_backbone_tracks,
+        gated,
     }
 }
 
@@ -372,7 +377,7 @@ fn search_flow(
 /// after a fixed flow, or a capped search, which kept everything already).
 fn complete_tracks(
     scene: &Scene,
-    network: &Restriction,
+    ruled: &Ruled,
     search: &mut SearchResult,
     flow: &Flow,
     stage: &dyn Fn(&str),
@@ -385,8 +390,14 @@ fn complete_tracks(
     }
     stage("completing feature tracks");
     let selection = &mut search.selection;
-    let done =
-        track_completion::complete(scene, network, &mut selection.pairs, &settings.completion);
+    let (network, gated) = (&ruled.network, &ruled.gated);
+    let done = track_completion::complete(
+        scene,
+        network,
+        gated,
+        &mut selection.pairs,
+        &settings.completion,
+    );
     let edges = scene.graph.edges.iter();
     for (e, _) in edges.zip(&selection.pairs).filter(|(_, &k)| k) {
         selection.images[e.i as usize] = true;

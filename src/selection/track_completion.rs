@@ -217,19 +217,28 @@ fn image_needs(full: &mut TrackSet, vertices: usize, n: usize) -> Vec<usize> {
 }
 
 /// Adds to `kept` (one flag per view-graph edge, the flow's selection) the pairs `needs` asks
-/// for, choosing among the edges `restriction` lets the search select.
+/// for, choosing among the edges `restriction` lets the search select; the track-length need
+/// may also take the edges `lengthen` marks, and its reference counts them.
 pub fn complete(
     scene: &Scene,
     restriction: &Restriction,
+    lengthen: &[bool],
     kept: &mut [bool],
     needs: &Needs,
 ) -> Completion {
     let selectable = restriction.expand_pairs(&vec![true; restriction.problem.pairs.len()]);
     let mut full = TrackSet::build(scene, |e| selectable[e] || kept[e]);
+    let lengthening: Vec<bool> = (0..selectable.len())
+        .map(|e| selectable[e] || lengthen[e])
+        .collect();
+    let reference = match lengthen.iter().any(|&l| l) {
+        true => TrackSet::build(scene, |e| lengthening[e] || kept[e]).mean_length(),
+        false => full.mean_length(),
+    };
     let mut tracks = TrackSet::build(scene, |e| kept[e]);
     let mut done = Completion {
         pairs_from_flow: kept.iter().filter(|&&k| k).count(),
-        track_length_full: full.mean_length(),
+        track_length_full: reference,
         track_length_flow: tracks.mean_length(),
         ..Completion::default()
     };
@@ -250,7 +259,7 @@ pub fn complete(
     }
     let target = needs.min_track_length_ratio * done.track_length_full;
     done.pairs_added_for_track_length =
-        add_for_track_length(scene, &selectable, kept, &mut tracks, target);
+        add_for_track_length(scene, &lengthening, kept, &mut tracks, target);
     done.track_length = tracks.mean_length();
     done
 }
@@ -412,9 +421,15 @@ mod tests {
             .count()
     }
 
+    /// The test's stand-in for the backbone-tracks gate: removed edges of even index.
+    fn gated(rules: &[ArcRule], e: usize) -> bool {
+        rules[e] == ArcRule::Removed && e.is_multiple_of(2)
+    }
+
     /// Images 1..=n of `kps` keypoints each and `pairs`: `setup(m)` gives each of the m
     /// view-graph edges its network rule and whether the flow kept it; the completion of
-    /// `needs` runs, and `check(scene, rules, start, kept, done)` judges it.
+    /// `needs` runs, and `check(scene, rules, start, kept, done)` judges it. The track-length
+    /// need may take the [`gated`] edges.
     fn run(
         n: u32,
         pairs: &[VerifiedPair],
@@ -446,7 +461,8 @@ mod tests {
         let (rules, start) = setup(graph.edges.len());
         let restriction = problem.restrict(&vec![false; n as usize], &rules);
         let mut kept = start.clone();
-        let done = complete(&scene, &restriction, &mut kept, &needs);
+        let lengthen: Vec<bool> = (0..rules.len()).map(|e| gated(&rules, e)).collect();
+        let done = complete(&scene, &restriction, &lengthen, &mut kept, &needs);
         check(&scene, &rules, &start, &kept, done);
     }
 
@@ -495,9 +511,12 @@ mod tests {
                 needs,
                 setup,
                 |scene, rules, start, kept, done| {
-                    // The plain greedy: recompute every gain, take the best (ties to the higher index).
+                    // The plain greedy: recompute every gain, take the best (ties to the higher
+                    // index), among the free edges and the gated ones (even removed ones).
                     let m = rules.len();
-                    let selectable: Vec<bool> = rules.iter().map(|r| *r == ArcRule::Free).collect();
+                    let selectable: Vec<bool> = (0..m)
+                        .map(|e| rules[e] == ArcRule::Free || gated(rules, e))
+                        .collect();
                     let full: Vec<bool> = (0..m).map(|e| selectable[e] || start[e]).collect();
                     let target = ratio * mean_length(scene, &full);
                     let mut plain = start.to_vec();
