@@ -43,7 +43,7 @@ impl Named for Preset {
     // `prune --help` shows beside each option.
     fn help(self) -> &'static str {
         match self {
-            Preset::General => "Speed on ordinary scenes: image priors degree, track fraction, clustering; pair priors inliers, triangulation angle, overlap, infinite homography; pairs the rest of the view graph does not corroborate (backbone tracks below a gate, as false pairs between repeated facades) kept out of the flow and the spanning forests; the search keeps most images, then the track completion adds the pairs the images need to stay registrable and accurate",
+            Preset::General => "Speed on ordinary scenes: image priors degree, track fraction, clustering; pair priors inliers, triangulation angle, overlap, infinite homography; the search keeps most images, then the track completion adds the pairs the images need to stay registrable and accurate",
             Preset::Disambiguation => "Scenes with duplicate or symmetric structure, whatever the image order: pair prior backbone tracks (the share of a pair's inliers that tracks through each image's strongest pairs join), pairs below a fitness floor never selected; the paper's context, loop and multiple motions, loop fraction and unique tracks at weight 0 (in --scores)",
             Preset::PaperDisambiguation => "The paper's section 5.1 as written, for comparison: context similarity, loop consistency and multiple motions with uniform weights, no fitness floor, the paper's share of pairs; relies on the pair arcs following the capture order (--order)",
         }
@@ -96,16 +96,12 @@ fn general() -> Defaults {
             ],
             node_constant: 1.0,
             min_pair_fitness: 0.0,
-            // Chosen on castle: its false pairs all but one below 0.1, 41 of 234 true ones;
-            // the one false pair the preset kept turned ten cameras 14 degrees in COLMAP 4.2's
-            // global mapper in 4 of 10 runs (no model in 2), gated 30 of 30 in 14 of 14. The
-            // track completion's track-length need may still take gated pairs: without that,
-            // the rendered room100 (weak long-range true pairs, seams of the backbone) lost
-            // 1,524 of 3,494 pairs and its positions were three times less accurate. Judged:
-            // lego 94 -> 100 of 100 with the global mapper (errors 1.15x with COLMAP 3.8),
-            // templeRing and room60 no loss, fountain and Herz-Jesus the same selection
-            // (docs/priors.md).
-            min_backbone_tracks: 0.1,
+            // Off: at 0.1 (`--min_backbone_tracks`) castle's one false pair goes and COLMAP
+            // 4.2's global mapper places 30 of 30 in 14 of 14 runs (4 of 10 without), lego
+            // 100 of 100 (94), but the gate prefers short baselines: the held-out generated
+            // orbits' positions came out 1.4x (600 images) to 1.95x (300) less accurate, lego's
+            // 1.15x with COLMAP 3.8 (docs/priors.md).
+            min_backbone_tracks: 0.0,
         },
         criteria: criteria(0.9, 0.0, 0.0),
         completion: Needs {
