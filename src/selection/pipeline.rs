@@ -298,7 +298,6 @@ fn apply_arc_rules(
     };
     let gated = before.iter().zip(&edges).map(|(a, b)| a != b).collect();
     let rule = parameters.flow.rule();
-    let fitness = || costs.pair_costs.iter().map(|c| -c);
     let floor = arc_rules::fitness_floor(
         model.min_pair_fitness,
         &rule,
@@ -306,7 +305,8 @@ fn apply_arc_rules(
         &edges,
         &costs.pair_costs,
     );
-    let below_fitness_floor = arc_rules::remove_below(&mut edges, fitness(), floor);
+    let fitness = costs.pair_costs.iter().map(|c| -c);
+    let below_fitness_floor = arc_rules::remove_below(&mut edges, fitness, floor);
     let network = problem(graph, costs, order)
         .restrict(&order.by_rank(&overrides.forbidden_vertices), &edges);
     Ruled {
@@ -374,7 +374,8 @@ fn search_flow(
 }
 
 /// Stage 6: after a search, the track completion adds the pairs the feature tracks need (none
-/// after a fixed flow, or a capped search, which kept everything already).
+/// after a fixed flow, or a capped search, which kept everything already); its track-length
+/// need may take the pairs the backbone-tracks gate kept from the flow.
 fn complete_tracks(
     scene: &Scene,
     ruled: &Ruled,
