@@ -188,7 +188,7 @@ pub fn plan(
         completion,
         fitness_floor: ruled.fitness_floor,
         below_fitness_floor: ruled.below_fitness_floor,
-        below_backbone_tracks: ruled.below_backbone_tracks,
+        below_backbone_tracks: ruled.gated.iter().filter(|&&g| g).count(),
         edits,
         timings,
         data_version,
@@ -268,7 +268,6 @@ struct Ruled {
     neighbours_kept: usize,
     fitness_floor: f64,
     below_fitness_floor: usize,
-    below_backbone_tracks: usize,
     /// Per view-graph edge: taken out by the backbone-tracks gate.
     gated: Vec<bool>,
 }
@@ -289,14 +288,14 @@ fn apply_arc_rules(
     let model = &parameters.cost_model;
     let gate = model.min_backbone_tracks;
     let share = (costs.pair_fitness.iter()).find(|p| p.prior == Prior::BackboneTracks);
-    let before = edges.clone();
-    let below_backbone_tracks = match share {
+    let gated = match share {
         Some(share) if gate > 0.0 => {
-            arc_rules::remove_below(&mut edges, share.values.iter().copied(), gate)
+            let before = edges.clone();
+            arc_rules::remove_below(&mut edges, share.values.iter().copied(), gate);
+            before.iter().zip(&edges).map(|(a, b)| a != b).collect()
         }
-        _ => 0,
+        _ => vec![false; edges.len()],
     };
-    let gated = before.iter().zip(&edges).map(|(a, b)| a != b).collect();
     let rule = parameters.flow.rule();
     let floor = arc_rules::fitness_floor(
         model.min_pair_fitness,
@@ -314,7 +313,6 @@ fn apply_arc_rules(
         neighbours_kept,
         fitness_floor: floor,
         below_fitness_floor,
-        below_backbone_tracks,
         gated,
     }
 }
@@ -391,11 +389,10 @@ fn complete_tracks(
     }
     stage("completing feature tracks");
     let selection = &mut search.selection;
-    let (network, gated) = (&ruled.network, &ruled.gated);
     let done = track_completion::complete(
         scene,
-        network,
-        gated,
+        &ruled.network,
+        &ruled.gated,
         &mut selection.pairs,
         &settings.completion,
     );
