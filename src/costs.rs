@@ -146,11 +146,13 @@ pub struct CostModel {
     pub min_pair_fitness: f64,
     /// Pairs whose `backbone_tracks` fitness (with [`Trapezoid::FRACTION`], its share: the
     /// inliers that chains of matches through the images' strongest pairs also join) is below
-    /// this are left out of the network whatever their cost; 0 is off. The model must list
-    /// that prior (at weight 0 where it only gates). The rest of the view graph does not
-    /// corroborate such a pair: on repeated structure (castle, lego) the false pairs are nearly
-    /// all of them, but so are a dense scene's weak long-range true pairs (docs/priors.md).
-    /// Recorded runs from before it load with 0, as they ran.
+    /// this are not added by the track completion's spanning forests and per-image need
+    /// (`selection::track_completion`); 0 is off. The model must list that prior (at weight 0
+    /// where it only gates). The rest of the view graph does not corroborate such a pair: on
+    /// repeated structure (castle, lego) the false pairs are nearly all of them, but so are a
+    /// dense scene's weak long-range true pairs and the seams of the backbone, which the flow
+    /// and the track-length need may still select (docs/priors.md). Recorded runs from before
+    /// it load with 0, as they ran.
     #[serde(default, skip_serializing_if = "is_off")]
     pub min_backbone_tracks: f64,
 }

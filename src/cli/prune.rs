@@ -130,10 +130,10 @@ pub struct PruneArgs {
     #[arg(long, value_parser = fraction, help_heading = EXPERT)]
     min_pair_fitness: Option<f64>,
     /// Pairs whose backbone_tracks share (of their inliers, those that chains of matches
-    /// through the images' strongest pairs also join) is below this are kept out of the flow
-    /// and the track completion's spanning forests (its track-length need may still take
-    /// them): the rest of the view graph does not corroborate them, as with false pairs
-    /// between repeated structures. 0 turns the gate off.
+    /// through the images' strongest pairs also join) is below this are not added by the track
+    /// completion's spanning forests and per-image need: the rest of the view graph does not
+    /// corroborate them, as with false pairs between repeated structures. The flow, on its
+    /// costs, and the track-length need may still select them. 0 turns the gate off.
     #[arg(long, value_parser = fraction, help_heading = EXPERT)]
     min_backbone_tracks: Option<f64>,
 }

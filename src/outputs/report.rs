@@ -62,8 +62,9 @@ pub struct Report {
     pub pairs_below_fitness_floor: usize,
     /// The cost model's `min_backbone_tracks` (0: no gate).
     pub min_backbone_tracks: f64,
-    /// Edges never offered to the flow: their `backbone_tracks` share below
-    /// `min_backbone_tracks` (the view graph does not corroborate them).
+    /// Edges offered to the flow whose `backbone_tracks` share is below `min_backbone_tracks`
+    /// (the view graph does not corroborate them): the track completion's spanning forests
+    /// and per-image need pass over them.
     pub pairs_below_backbone_tracks: usize,
     /// The view graph before the prune.
     pub graph_before: GraphStats,

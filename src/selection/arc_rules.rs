@@ -4,15 +4,16 @@
 //! are removed, and the pairs that link clean models placed in one frame are kept, whatever an
 //! earlier model blamed; see [`crate::check::loop_evidence`]), the user's overrides
 //! (`--forbid_images`, `--forbid_pairs`, which win over the models', then `--keep_pairs`),
-//! close neighbours in a capture sequence (`--keep_neighbours`), the pairs the view graph does
-//! not corroborate (`--min_backbone_tracks`), and the fitness floor (`--min_pair_fitness`,
-//! lowered as far as the search needs).
+//! close neighbours in a capture sequence (`--keep_neighbours`), and the fitness floor
+//! (`--min_pair_fitness`, lowered as far as the search needs). The pairs the view graph does
+//! not corroborate (`--min_backbone_tracks`) are no arc rule: the flow may select them, the
+//! track completion's forests do not add them.
 //!
 //! Rules change the network ([`crate::flow::network::SelectionProblem::restrict`]), never
 //! the costs, so the result stays an exact min-cost flow and is easy to explain:
 //! - a forbidden image leaves the network with all its pairs; the search criteria count only the
 //!   images that remain;
-//! - a forbidden pair's arc, or one below the gate or the floor, leaves the network;
+//! - a forbidden pair's arc, or one below the floor, leaves the network;
 //! - a kept pair's arc leaves the network too, and the pair (with both its images) is added to
 //!   whatever the flow selects. The flow optimises the rest of the graph: the criteria and the
 //!   selection curve describe the flow's part, before the kept pairs are added.

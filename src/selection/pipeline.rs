@@ -86,8 +86,8 @@ pub struct Plan {
     pub fitness_floor: f64,
     /// Free edges (neither kept nor forbidden) below `fitness_floor`, taken out of the network.
     pub below_fitness_floor: usize,
-    /// Free edges whose `backbone_tracks` share is below the cost model's
-    /// `min_backbone_tracks`, taken out of the network before the floor.
+    /// Edges the network offers whose `backbone_tracks` share is below the cost model's
+    /// `min_backbone_tracks`: the track completion's forests and image need pass over them.
     pub below_backbone_tracks: usize,
     /// What the write does: the view-graph edges the selection leaves out are invalidated.
     pub edits: Edits,
@@ -153,7 +153,7 @@ pub fn plan(
     let costs = costs::compute(&parameters.cost_model, &image_priors, &pair_priors.values);
     timings.priors = t.elapsed().as_secs_f64();
 
-    // 4. Arc rules: close neighbours kept, pairs below the gate and the fitness floor removed.
+    // 4. Arc rules: close neighbours kept, pairs below the floor removed, below the gate marked.
     stage("solving the min-cost flow selection");
     let t = Instant::now();
     let ruled = apply_arc_rules(parameters, &rules, &graph, &costs, &order);
@@ -188,7 +188,7 @@ pub fn plan(
         completion,
         fitness_floor: ruled.fitness_floor,
         below_fitness_floor: ruled.below_fitness_floor,
-        below_backbone_tracks: ruled.gated.iter().filter(|&&g| g).count(),
+        below_backbone_tracks: ruled.uncorroborated.iter().filter(|&&u| u).count(),
         edits,
         timings,
         data_version,
@@ -268,13 +268,14 @@ struct Ruled {
     neighbours_kept: usize,
     fitness_floor: f64,
     below_fitness_floor: usize,
-    /// Per view-graph edge: taken out by the backbone-tracks gate.
-    gated: Vec<bool>,
+    /// Per view-graph edge: one the network offers whose `backbone_tracks` share is below the
+    /// cost model's `min_backbone_tracks`; the completion's forests and image need pass over it.
+    uncorroborated: Vec<bool>,
 }
 
-/// Stage 4: to the overrides' rules, adds the close neighbours kept, the pairs below the
-/// backbone-tracks gate and those below the fitness floor, and restricts the paper's network by
-/// them.
+/// Stage 4: to the overrides' rules, adds the close neighbours kept and the pairs below the
+/// fitness floor, restricts the paper's network by them, and marks the pairs it offers that
+/// the backbone-tracks gate leaves to the flow and the track-length need.
 fn apply_arc_rules(
     parameters: &Parameters,
     overrides: &Resolved,
@@ -286,16 +287,6 @@ fn apply_arc_rules(
     let window = parameters.arc_rules.keep_neighbours;
     let neighbours_kept = arc_rules::keep_neighbours(&mut edges, graph, order, window);
     let model = &parameters.cost_model;
-    let gate = model.min_backbone_tracks;
-    let share = (costs.pair_fitness.iter()).find(|p| p.prior == Prior::BackboneTracks);
-    let gated = match share {
-        Some(share) if gate > 0.0 => {
-            let before = edges.clone();
-            arc_rules::remove_below(&mut edges, share.values.iter().copied(), gate);
-            before.iter().zip(&edges).map(|(a, b)| a != b).collect()
-        }
-        _ => vec![false; edges.len()],
-    };
     let rule = parameters.flow.rule();
     let floor = arc_rules::fitness_floor(
         model.min_pair_fitness,
@@ -308,12 +299,26 @@ fn apply_arc_rules(
     let below_fitness_floor = arc_rules::remove_below(&mut edges, fitness, floor);
     let network = problem(graph, costs, order)
         .restrict(&order.by_rank(&overrides.forbidden_vertices), &edges);
+    let uncorroborated = uncorroborated(&network, costs, model.min_backbone_tracks);
     Ruled {
         network,
         neighbours_kept,
         fitness_floor: floor,
         below_fitness_floor,
-        gated,
+        uncorroborated,
+    }
+}
+
+/// Per view-graph edge: one `network` offers whose `backbone_tracks` share is below `gate`
+/// (none with the gate at 0).
+fn uncorroborated(network: &Restriction, costs: &Costs, gate: f64) -> Vec<bool> {
+    let selectable = network.expand_pairs(&vec![true; network.problem.pairs.len()]);
+    let share = (costs.pair_fitness.iter()).find(|p| p.prior == Prior::BackboneTracks);
+    match share {
+        Some(share) if gate > 0.0 => (selectable.iter().zip(&share.values))
+            .map(|(&s, &v)| s && v < gate)
+            .collect(),
+        _ => vec![false; selectable.len()],
     }
 }
 
@@ -372,8 +377,8 @@ fn search_flow(
 }
 
 /// Stage 6: after a search, the track completion adds the pairs the feature tracks need (none
-/// after a fixed flow, or a capped search, which kept everything already); its track-length
-/// need may take the pairs the backbone-tracks gate kept from the flow.
+/// after a fixed flow, or a capped search, which kept everything already); its forests and
+/// image need pass over the pairs below the backbone-tracks gate.
 fn complete_tracks(
     scene: &Scene,
     ruled: &Ruled,
@@ -392,7 +397,7 @@ fn complete_tracks(
     let done = track_completion::complete(
         scene,
         &ruled.network,
-        &ruled.gated,
+        &ruled.uncorroborated,
         &mut selection.pairs,
         &settings.completion,
     );

@@ -96,11 +96,7 @@ fn general() -> Defaults {
             ],
             node_constant: 1.0,
             min_pair_fitness: 0.0,
-            // Off: at 0.1 (`--min_backbone_tracks`) castle's one false pair goes and COLMAP
-            // 4.2's global mapper places 30 of 30 in 14 of 14 runs (4 of 10 without), lego
-            // 100 of 100 (94), but the gate prefers short baselines: the held-out generated
-            // orbits' positions came out 1.4x (600 images) to 1.95x (300) less accurate, lego's
-            // 1.15x with COLMAP 3.8 (docs/priors.md).
+            // Off: at 0.1 (`--min_backbone_tracks`) castle's one false pair goes (docs/priors.md).
             min_backbone_tracks: 0.0,
         },
         criteria: criteria(0.9, 0.0, 0.0),
