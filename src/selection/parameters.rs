@@ -471,15 +471,15 @@ mod tests {
             ..Given::default()
         };
         assert!(Parameters::resolve(unknown).is_err());
-        // The general preset reads backbone_tracks only for its gate, which a window shapes;
-        // with the gate off (its default) nothing reads it.
+        // The general preset reads backbone_tracks only for its gate (on by default), which a
+        // window shapes; with the gate off nothing reads it.
         let window = |gate| Given {
             sequence_window: Some(3),
             min_backbone_tracks: gate,
             ..Given::default()
         };
-        assert!(Parameters::resolve(window(Some(0.1))).is_ok());
-        let error = Parameters::resolve(window(None)).unwrap_err();
+        assert!(Parameters::resolve(window(None)).is_ok());
+        let error = Parameters::resolve(window(Some(0.0))).unwrap_err();
         assert!(error.to_string().contains("--preset general"), "{error}");
     }
 }
