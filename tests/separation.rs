@@ -1,6 +1,6 @@
 //! Separation of true and false pairs on the generated duplicate-structure scene: each pair
 //! prior's AUC against the ground-truth labels, what `--preset disambiguation` removes, and the
-//! general preset's backbone-tracks gate.
+//! general preset's backbone-tracks gate, and the seams it leaves to the flow.
 //! `cargo test --test separation -- --nocapture` prints the table; the ignored test runs a
 //! bigger scene (`cargo test --release --test separation -- --ignored --nocapture`).
 
@@ -8,10 +8,12 @@ use std::time::Instant;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::eval::separation::{measure, Separation};
 use vgsel_colmap::eval::synth::{generate, GroundTruth, SceneSpec, SyntheticScene};
+use vgsel_colmap::priors::Prior;
 use vgsel_colmap::selection::arc_rules::Overrides;
-use vgsel_colmap::selection::parameters::Parameters;
+use vgsel_colmap::selection::parameters::{Flow, Parameters};
 use vgsel_colmap::selection::pipeline::{plan, Extras, Plan};
 use vgsel_colmap::selection::preset::Preset;
+use vgsel_colmap::selection::track_completion::Needs;
 
 /// The disambiguation preset plus the general preset's pair priors at weight 0, so that one run
 /// measures every pair prior.
@@ -123,4 +125,50 @@ fn the_general_presets_gate_keeps_uncorroborated_pairs_out() {
     assert!(kept(&gated) <= 1.0);
     assert_eq!(gated.images_without_pair, 0);
     assert_eq!(gated.true_components, 1);
+}
+
+/// The gate leaves the flow its seams: on an 80-image orbit the flow selects neighbours the
+/// backbone joins only the long way round (share 0), and the gated selection keeps every pair
+/// the flow selected. Gating the flow too (session 32) cut a 300-image orbit at such a pair and
+/// doubled its position error (docs/priors.md).
+#[test]
+fn the_general_presets_gate_leaves_the_flow_its_seams() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("orbit.db");
+    let spec = SceneSpec {
+        num_images: 80,
+        view_cone_degrees: 20.0,
+        seed: 1,
+        ..SceneSpec::default()
+    };
+    generate(&spec, &path).unwrap();
+    let db = Database::open_read_only(&path).unwrap();
+    let general = |completion: bool| {
+        let mut parameters = Parameters::of_preset(Preset::General);
+        assert_eq!(parameters.cost_model.min_backbone_tracks, 0.1);
+        if let (false, Flow::Searched(search)) = (completion, &mut parameters.flow) {
+            search.completion = Needs::OFF;
+        }
+        plan(
+            &db,
+            &parameters,
+            &Overrides::default(),
+            Extras::default(),
+            &|_| {},
+        )
+        .unwrap()
+    };
+    let (flow, completed) = (general(false), general(true));
+    let share = (flow.pair_priors.iter())
+        .find(|p| p.prior == Prior::BackboneTracks)
+        .unwrap();
+    let selected = |p: &Plan| p.search.selection.pairs.clone();
+    let (flow_pairs, kept) = (selected(&flow), selected(&completed));
+    let seams = (0..flow_pairs.len()).filter(|&e| flow_pairs[e] && share.values[e] < 0.1);
+    assert!(
+        seams.count() >= 1,
+        "the orbit must have a seam the flow selects"
+    );
+    assert!((0..kept.len()).all(|e| !flow_pairs[e] || kept[e]));
+    assert!(completed.below_backbone_tracks > 0);
 }
