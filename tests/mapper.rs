@@ -1,13 +1,13 @@
 //! End-to-end: a synthetic database through the real `colmap mapper` (3.8), aligned to the
 //! ground truth. Needs `colmap` on PATH (the project's install script provides it).
 
-use crate::support::run_ok;
+use crate::support::{duplicate_scene, run_ok};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 use vgsel_colmap::colmap::sparse::read_images;
 use vgsel_colmap::eval::align::evaluate;
-use vgsel_colmap::eval::synth::{generate, write_gt_model, GroundTruth, SceneSpec, SyntheticScene};
+use vgsel_colmap::eval::synth::{generate, write_gt_model, GroundTruth, SceneSpec};
 
 fn colmap() -> Command {
     let ok = Command::new("colmap")
@@ -151,17 +151,7 @@ fn mapper_reconstructs_pruned_synthetic_scene() {
 fn the_general_preset_maps_the_duplicate_scene_whole() {
     let dir = tempfile::tempdir().unwrap();
     let db = dir.path().join("database.db");
-    let spec = SceneSpec {
-        num_images: 36,
-        num_points: 5000,
-        seed: 3,
-        scene: SyntheticScene::Duplicate {
-            yaw_degrees: 0.0,
-            overview_images: 4,
-        },
-        ..SceneSpec::default()
-    };
-    let gt = generate(&spec, &db).unwrap();
+    let gt = generate(&duplicate_scene(36, 5000, 0.0), &db).unwrap();
     let mut prune = Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"));
     run_ok(prune.args(["prune", "--quiet", "--database_path"]).arg(&db));
     map_and_check(dir.path(), &db, &gt);

@@ -4,10 +4,11 @@
 //! `cargo test --test separation -- --nocapture` prints the table; the ignored test runs a
 //! bigger scene (`cargo test --release --test separation -- --ignored --nocapture`).
 
+use crate::support::duplicate_scene;
 use std::time::Instant;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::eval::separation::{measure, Separation};
-use vgsel_colmap::eval::synth::{generate, GroundTruth, SceneSpec, SyntheticScene};
+use vgsel_colmap::eval::synth::{generate, GroundTruth, SceneSpec};
 use vgsel_colmap::priors::Prior;
 use vgsel_colmap::selection::arc_rules::Overrides;
 use vgsel_colmap::selection::parameters::{Flow, Parameters};
@@ -45,19 +46,6 @@ fn run(spec: &SceneSpec) -> (Plan, GroundTruth, Separation) {
     (p, gt, s)
 }
 
-fn duplicate(num_images: usize, num_points: usize, yaw_degrees: f64) -> SceneSpec {
-    SceneSpec {
-        num_images,
-        num_points,
-        scene: SyntheticScene::Duplicate {
-            yaw_degrees,
-            overview_images: 4,
-        },
-        seed: 3,
-        ..SceneSpec::default()
-    }
-}
-
 fn auc(s: &Separation, name: &str) -> f64 {
     s.priors
         .iter()
@@ -69,7 +57,7 @@ fn auc(s: &Separation, name: &str) -> f64 {
 
 #[test]
 fn duplicate_scene_is_separated() {
-    let (_, _, s) = run(&duplicate(36, 5000, 0.0));
+    let (_, _, s) = run(&duplicate_scene(36, 5000, 0.0));
     assert!(s.false_pairs >= 10, "the scene must have false pairs");
     assert!(auc(&s, "loop_fraction") >= 0.95);
     // The preset's cost (backbone_tracks) ranks less well here (0.79 when written) than on real
@@ -86,7 +74,7 @@ fn duplicate_scene_is_separated() {
 fn bigger_duplicate_scenes() {
     for yaw in [0.0, 40.0] {
         eprintln!("== 80 images, 12000 points, yaw {yaw}");
-        run(&duplicate(80, 12000, yaw));
+        run(&duplicate_scene(80, 12000, yaw));
     }
 }
 
@@ -97,7 +85,7 @@ fn bigger_duplicate_scenes() {
 fn the_general_presets_gate_keeps_uncorroborated_pairs_out() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("duplicate.db");
-    let gt = generate(&duplicate(36, 5000, 0.0), &path).unwrap();
+    let gt = generate(&duplicate_scene(36, 5000, 0.0), &path).unwrap();
     let db = Database::open_read_only(&path).unwrap();
     let general = |gate: f64| {
         let mut parameters = Parameters::of_preset(Preset::General);

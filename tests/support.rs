@@ -322,6 +322,25 @@ pub fn scene() -> (TempDir, PathBuf) {
     (dir, db)
 }
 
+/// The generated duplicate-structure scene of the separation and mapper tests: two copies of
+/// the object, the second turned by `yaw_degrees`, with 4 overview images (seed 3).
+pub fn duplicate_scene(
+    num_images: usize,
+    num_points: usize,
+    yaw_degrees: f64,
+) -> vgsel_colmap::eval::synth::SceneSpec {
+    vgsel_colmap::eval::synth::SceneSpec {
+        num_images,
+        num_points,
+        scene: vgsel_colmap::eval::synth::SyntheticScene::Duplicate {
+            yaw_degrees,
+            overview_images: 4,
+        },
+        seed: 3,
+        ..Default::default()
+    }
+}
+
 /// Every file under `dir` (names relative to it) with its bytes.
 pub fn snapshot(dir: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
     let mut out = std::collections::BTreeMap::new();
