@@ -146,14 +146,20 @@ fn mapper_reconstructs_pruned_synthetic_scene() {
 /// The general preset on the generated duplicate scene (36 images, two copies of the object):
 /// without its backbone-tracks gate the track completion's forests kept 27 false pairs between
 /// the copies and COLMAP 3.8 placed 34 of 36 cameras (session 33, docs/priors.md); gated, one
-/// false pair is left and every camera is placed right.
+/// false pair is left, the summary says how many pairs the gate held back, and every camera
+/// is placed right.
 #[test]
 fn the_general_preset_maps_the_duplicate_scene_whole() {
     let dir = tempfile::tempdir().unwrap();
     let db = dir.path().join("database.db");
     let gt = generate(&duplicate_scene(36, 5000, 0.0), &db).unwrap();
     let mut prune = Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"));
-    run_ok(prune.args(["prune", "--quiet", "--database_path"]).arg(&db));
+    let out = run_ok(prune.args(["prune", "--database_path"]).arg(&db));
+    let summary = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        summary.contains("pairs below the backbone-tracks gate"),
+        "{summary}"
+    );
     map_and_check(dir.path(), &db, &gt);
 }
 

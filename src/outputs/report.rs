@@ -190,10 +190,14 @@ impl Report {
     pub fn summary(&self) -> String {
         let mut s = self.headline();
         if let Some(c) = &self.completion {
+            let gated = match self.pairs_below_backbone_tracks {
+                0 => String::new(),
+                n => format!(" (passing over {n} pairs below the backbone-tracks gate)"),
+            };
             s += &format!(
                 "track completion: the flow kept {} pairs; {} added from the strongest spanning \
-                 forests, {} for {} images short of keypoints on tracks, {} for the track length \
-                 ({:.1} -> {:.1}; full graph {:.1})\n",
+                 forests{gated}, {} for {} images short of keypoints on tracks, {} for the track \
+                 length ({:.1} -> {:.1}; full graph {:.1})\n",
                 c.pairs_from_flow,
                 c.pairs_added_for_spanning_forests,
                 c.pairs_added_for_images,
