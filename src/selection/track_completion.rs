@@ -22,7 +22,6 @@
 //!    tracks: on the rendered room100 the flow's chain kept 42% of it and its cameras' positions
 //!    were 1.5x less accurate; 60% (224 pairs) left 1.48x, 70% (418 pairs) 0.98x.
 //!
-//!
 //! Needs 1 and 2 take no pair the view graph does not corroborate (its `backbone_tracks` share
 //! below `--min_backbone_tracks`): they add pairs on strength alone, and on repeated structure
 //! the strongest pair across a weak cut is often a false one between copies (castle's 0001-0024,
