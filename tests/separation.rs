@@ -78,6 +78,14 @@ fn bigger_duplicate_scenes() {
     }
 }
 
+/// The general preset's plan of `db`, its parameters changed by `adjust` first.
+fn general_plan(db: &Database, adjust: impl FnOnce(&mut Parameters)) -> Plan {
+    let mut parameters = Parameters::of_preset(Preset::General);
+    adjust(&mut parameters);
+    let overrides = Overrides::default();
+    plan(db, &parameters, &overrides, Extras::default(), &|_| {}).unwrap()
+}
+
 /// The general preset's backbone-tracks gate (`--min_backbone_tracks`): on the duplicate scene
 /// the general selection keeps false pairs without it and far fewer with it, and the gate
 /// leaves no image without a pair nor the true pairs kept in pieces.
@@ -88,16 +96,8 @@ fn the_general_presets_gate_keeps_uncorroborated_pairs_out() {
     let gt = generate(&duplicate_scene(36, 5000, 0.0), &path).unwrap();
     let db = Database::open_read_only(&path).unwrap();
     let general = |gate: f64| {
-        let mut parameters = Parameters::of_preset(Preset::General);
-        parameters.cost_model.min_backbone_tracks = gate;
-        let p = plan(
-            &db,
-            &parameters,
-            &Overrides::default(),
-            Extras::default(),
-            &|_| {},
-        );
-        measure(&p.unwrap(), &gt)
+        let p = general_plan(&db, |p| p.cost_model.min_backbone_tracks = gate);
+        measure(&p, &gt)
     };
     let (open, gated) = (general(0.0), general(0.1));
     let kept = |s: &Separation| ((1.0 - s.false_removed) * s.false_pairs as f64).round();
@@ -132,19 +132,12 @@ fn the_general_presets_gate_leaves_the_flow_its_seams() {
     generate(&spec, &path).unwrap();
     let db = Database::open_read_only(&path).unwrap();
     let general = |completion: bool| {
-        let mut parameters = Parameters::of_preset(Preset::General);
-        assert_eq!(parameters.cost_model.min_backbone_tracks, 0.1);
-        if let (false, Flow::Searched(search)) = (completion, &mut parameters.flow) {
-            search.completion = Needs::OFF;
-        }
-        plan(
-            &db,
-            &parameters,
-            &Overrides::default(),
-            Extras::default(),
-            &|_| {},
-        )
-        .unwrap()
+        general_plan(&db, |parameters| {
+            assert_eq!(parameters.cost_model.min_backbone_tracks, 0.1);
+            if let (false, Flow::Searched(search)) = (completion, &mut parameters.flow) {
+                search.completion = Needs::OFF;
+            }
+        })
     };
     let (flow, completed) = (general(false), general(true));
     let share = (flow.pair_priors.iter())

@@ -403,8 +403,7 @@ pub fn keep_neighbours(
     kept
 }
 
-/// Removes every free edge whose value (a fitness, −cost, or a prior's raw value) is below
-/// `min`. Returns how many.
+/// Removes every free edge whose value (a fitness, −cost) is below `min`. Returns how many.
 pub fn remove_below(
     rules: &mut [ArcRule],
     values: impl IntoIterator<Item = f64>,
