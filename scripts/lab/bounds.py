@@ -12,6 +12,9 @@ epipolar labels call true ("epipolar truth", the bound as it was measured before
 is mapped by COLMAP 3.8's `colmap mapper`, and with --global also by COLMAP 4.2's global mapper
 (pycolmap, scripts/ci/colmap4.py), and scored by `vgsel-colmap eval`: cameras correct of all.
 Prints a markdown table and writes WORK/bounds.json. Steps already done in WORK are not redone.
+Each model is also summed up by `colmap model_analyzer`: its observations and mean reprojection
+error, how well it explains the images (a fold that explains as many observations as the truth's
+model, as finely, is a reconstruction no check on the model can refuse).
 
 usage: scripts/lab/bounds.py [--work DIR] [--global] [DESIGN:IMAGES:SEED ...]
        (WORK defaults to target/bounds)
@@ -20,6 +23,7 @@ import argparse
 import csv
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -86,6 +90,21 @@ def only(db, out, label, work):
     return out
 
 
+def explained(sparse):
+    """(observations, mean reprojection error in px) over every model in sparse/, from
+    `colmap model_analyzer`; the error is weighted by each model's observations."""
+    total, weighted = 0, 0.0
+    for sub in sorted(os.listdir(sparse)):
+        path = os.path.join(sparse, sub)
+        if not os.path.isdir(path):
+            continue
+        text = run(["colmap", "model_analyzer", "--path", path])
+        obs = int(re.search(r"Observations: (\d+)", text).group(1))
+        error = float(re.search(r"Mean reprojection error: ([0-9.]+)px", text).group(1))
+        total, weighted = total + obs, weighted + obs * error
+    return total, (weighted / total if total else None)
+
+
 def map_and_score(db, images, gt, sparse, kind, baseline):
     """Maps a copy of db into sparse/ (COLMAP 3.8, or 4.2's global mapper) unless done, and
     scores it: (correct, registered, models, false pairs used)."""
@@ -108,9 +127,11 @@ def map_and_score(db, images, gt, sparse, kind, baseline):
         open(sparse + ".done", "w").close()
     e = json.loads(run([VGSEL, "eval", "--model", sparse, "--ground_truth", gt,
                         "--database_path", db, "--baseline", baseline]))
+    observations, error = explained(sparse)
     return {"correct": e.get("correct") or 0, "registered": e["registered"],
             "models": e["models"], "false_used": e["pairs"]["false"],
-            "true_used": e["pairs"]["true"]}
+            "true_used": e["pairs"]["true"], "observations": observations,
+            "reprojection_px": error}
 
 
 def design(work, spec, mappers):
@@ -160,6 +181,11 @@ def cell(r, images):
     return f"{r['correct']}/{images}{models}, {r['false_used']} false"
 
 
+def explanation(r):
+    error = r["reprojection_px"]
+    return f"{r['observations']}, {error:.3f} px" if error is not None else "no model"
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("designs", nargs="*", default=DESIGNS)
@@ -180,6 +206,14 @@ def main():
                   f"{row['epipolar_true']} ({row['epipolar_true_false']}) | {kind} | {cells} |")
     print("(cells: cameras correct of the design's images, models when not one, false pairs the "
           "database lets the mapper use, by the exact labels)")
+    print()
+    print("| design | mapper | " + " | ".join(DATABASES) + " |")
+    print("|---" * (2 + len(DATABASES)) + "|")
+    for row in rows:
+        for kind in mappers:
+            cells = " | ".join(explanation(row[f"{label} / {kind}"]) for label in DATABASES)
+            print(f"| {row['design']} | {kind} | {cells} |")
+    print("(cells: observations of the models, mean reprojection error)")
 
 
 if __name__ == "__main__":
