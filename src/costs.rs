@@ -3,8 +3,9 @@
 //! Each prior goes through g: optionally min-max scaled over all images (or pairs), then a
 //! trapezoid that maps it to a fitness in [low, high] ⊂ [0, 1]. An image's cost is minus the
 //! weighted mean of its priors' fitness times a node constant; a pair's cost is minus the weighted
-//! mean of its priors' fitness. Only encouraging costs (<= 0) are used, as the paper does, so the
-//! flow F stays the one free parameter.
+//! mean of its priors' fitness, arithmetic as in the paper or geometric ([`Mean`]). Only
+//! encouraging costs (<= 0) are used, as the paper does, so the flow F stays the one free
+//! parameter.
 
 use crate::named::Named;
 use crate::priors::{Prior, PriorValues};
@@ -130,6 +131,37 @@ impl PriorModel {
     }
 }
 
+/// How a pair's priors' fitness make one fitness.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mean {
+    /// The weighted arithmetic mean, the paper's: a prior that rates a pair highly makes up
+    /// for one that rates it low.
+    #[default]
+    Arithmetic,
+    /// The weighted geometric mean: a pair is only as fit as every prior allows, and one prior
+    /// at 0 makes it 0. For priors that each miss false pairs of a different kind.
+    Geometric,
+}
+
+impl Named for Mean {
+    const ALL: &'static [Mean] = &[Mean::Arithmetic, Mean::Geometric];
+
+    fn name(self) -> &'static str {
+        match self {
+            Mean::Arithmetic => "arithmetic",
+            Mean::Geometric => "geometric",
+        }
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            Mean::Arithmetic => "The weighted mean of the pair priors' fitness (the paper's)",
+            Mean::Geometric => "The weighted geometric mean: every prior must rate a pair well",
+        }
+    }
+}
+
 /// Which priors make the costs, their g and weights (a preset's, [`crate::selection::preset`],
 /// with the user's changes).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -140,6 +172,10 @@ pub struct CostModel {
     pub pair_priors: Vec<PriorModel>,
     /// Scales image costs relative to pair costs (the authors ran 0, 0.5 and 1).
     pub node_constant: f64,
+    /// How the pair priors' fitness are averaged. Recorded runs from before it load as
+    /// arithmetic, as they ran.
+    #[serde(default, skip_serializing_if = "is_arithmetic")]
+    pub pair_mean: Mean,
     /// Pairs whose fitness (−cost) is below this are left out of the network, never selected.
     /// Any negative-cost arc lets a flow path run on from one copy of a duplicated structure to
     /// the other, so without a floor the flow keeps false pairs that rank low (docs/priors.md).
@@ -160,6 +196,11 @@ pub struct CostModel {
 /// A gate of 0 is not written, so that a record of a run without one reads as before it existed.
 fn is_off(gate: &f64) -> bool {
     *gate == 0.0
+}
+
+/// Nor is the arithmetic mean, for the same reason.
+fn is_arithmetic(mean: &Mean) -> bool {
+    *mean == Mean::Arithmetic
 }
 
 impl CostModel {
@@ -218,8 +259,10 @@ pub fn compute(
     image_priors: &[PriorValues],
     pair_priors: &[PriorValues],
 ) -> Costs {
-    let (image_fitness, image_mean) = weighted_fitness(&model.image_priors, image_priors);
-    let (pair_fitness, pair_mean) = weighted_fitness(&model.pair_priors, pair_priors);
+    let (image_fitness, image_mean) =
+        weighted_fitness(&model.image_priors, image_priors, Mean::Arithmetic);
+    let (pair_fitness, pair_mean) =
+        weighted_fitness(&model.pair_priors, pair_priors, model.pair_mean);
     Costs {
         image_costs: image_mean
             .iter()
@@ -231,10 +274,14 @@ pub fn compute(
     }
 }
 
-/// Each prior's fitness, and their weighted mean per item. A NaN raw value means the prior does
-/// not apply to that item (no second motion found, no triangle): its fitness is NaN and the mean
-/// is taken over the priors that apply. Priors of weight 0 may be left uncomputed.
-fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorValues>, Vec<f64>) {
+/// Each prior's fitness, and their weighted `mean` per item. A NaN raw value means the prior
+/// does not apply to that item (no second motion found, no triangle): its fitness is NaN and the
+/// mean is taken over the priors that apply. Priors of weight 0 may be left uncomputed.
+fn weighted_fitness(
+    models: &[PriorModel],
+    raw: &[PriorValues],
+    mean: Mean,
+) -> (Vec<PriorValues>, Vec<f64>) {
     let models: Vec<&PriorModel> = models
         .iter()
         .filter(|m| m.weight > 0.0 || raw.iter().any(|p| p.prior == m.prior))
@@ -266,9 +313,20 @@ fn weighted_fitness(models: &[PriorModel], raw: &[PriorValues]) -> (Vec<PriorVal
                     .zip(&fitness)
                     .filter(move |(_, f)| !f.values[k].is_nan())
             };
-            match present().map(|(m, _)| m.weight).sum::<f64>() {
-                w if w > 0.0 => present().map(|(m, f)| m.weight * f.values[k]).sum::<f64>() / w,
-                _ => 0.0,
+            let weighted = || present().filter(|(m, _)| m.weight > 0.0);
+            match weighted().map(|(m, _)| m.weight).sum::<f64>() {
+                w if w <= 0.0 => 0.0,
+                w => match mean {
+                    Mean::Arithmetic => {
+                        weighted().map(|(m, f)| m.weight * f.values[k]).sum::<f64>() / w
+                    }
+                    // exp of the weighted mean log; a fitness of 0 gives -inf, and exp(-inf) 0.
+                    Mean::Geometric => (weighted()
+                        .map(|(m, f)| m.weight * f.values[k].ln())
+                        .sum::<f64>()
+                        / w)
+                        .exp(),
+                },
             }
         })
         .collect();
@@ -318,6 +376,7 @@ mod tests {
                 .map(|p| PriorModel::new(p, Trapezoid::RISE, 1.0))
                 .to_vec(),
             node_constant: 1.0,
+            pair_mean: Mean::Arithmetic,
             min_pair_fitness: 0.0,
             min_backbone_tracks: 0.0,
         };
@@ -366,6 +425,7 @@ mod tests {
                 PriorModel::new(Prior::MotionRotation, Trapezoid::MOTION_ROTATION, 1.0),
             ],
             node_constant: 0.0,
+            pair_mean: Mean::Arithmetic,
             min_pair_fitness: 0.0,
             min_backbone_tracks: 0.0,
         };
@@ -382,5 +442,47 @@ mod tests {
         let c = compute(&model, &[], &pairs);
         assert_eq!(c.pair_costs, vec![-0.5, -0.25]);
         assert!(c.pair_fitness[1].values[0].is_nan());
+    }
+
+    /// Three shares as the disambiguation preset reads them, one of them absent for the third
+    /// pair and one weighted 0: the geometric mean is the product's root over the priors that
+    /// apply and have a weight, a share of 0 makes the pair 0 whatever the others say, and the
+    /// arithmetic mean of the same values lets the other two carry it.
+    #[test]
+    fn the_geometric_mean_needs_every_prior() {
+        let mut model = CostModel {
+            image_priors: vec![],
+            pair_priors: [
+                Prior::BackboneTracks,
+                Prior::UniqueTracks,
+                Prior::LoopFraction,
+                Prior::Context,
+            ]
+            .map(|p| PriorModel::new(p, Trapezoid::FRACTION, 1.0))
+            .to_vec(),
+            node_constant: 0.0,
+            pair_mean: Mean::Geometric,
+            min_pair_fitness: 0.0,
+            min_backbone_tracks: 0.0,
+        };
+        model.set_weight("context", 0.0).unwrap();
+        let shares = |prior, values: [f64; 3]| PriorValues {
+            prior,
+            values: values.to_vec(),
+        };
+        let pairs = [
+            shares(Prior::BackboneTracks, [1.0, 1.0, 0.25]),
+            shares(Prior::UniqueTracks, [0.5, 0.0, 1.0]),
+            shares(Prior::LoopFraction, [0.25, 1.0, f64::NAN]),
+            shares(Prior::Context, [0.0, 0.0, 0.0]),
+        ];
+        let c = compute(&model, &[], &pairs);
+        let expected = [0.125f64.cbrt(), 0.0, 0.5];
+        for (cost, want) in c.pair_costs.iter().zip(expected) {
+            assert!((cost + want).abs() < 1e-12, "{:?}", c.pair_costs);
+        }
+        model.pair_mean = Mean::Arithmetic;
+        let c = compute(&model, &[], &pairs);
+        assert_eq!(c.pair_costs, vec![-1.75 / 3.0, -2.0 / 3.0, -0.625]);
     }
 }

@@ -2,6 +2,7 @@
 //! here and compared verbatim, so a default changed in one place and not the other fails. On a
 //! mismatch the message holds the table to paste between the README's markers.
 
+use vgsel_colmap::costs::Mean;
 use vgsel_colmap::named::Named;
 use vgsel_colmap::selection::preset::{Defaults, Preset};
 
@@ -21,8 +22,17 @@ fn row(preset: Preset, d: &Defaults) -> String {
         .map(|p| p.prior.name())
         .collect();
     let mut priors = weighted.join(", ");
+    if model.pair_mean == Mean::Geometric {
+        priors = format!("geometric mean of {priors}");
+    }
     if !unweighted.is_empty() {
         priors += &format!("; {} (0)", unweighted.join(", "));
+    }
+    if !d.sequence_weights.is_empty() {
+        let set: Vec<String> = (d.sequence_weights.iter())
+            .map(|(p, w)| format!("{} ({w})", p.name()))
+            .collect();
+        priors += &format!("; with `--sequence_window`: {}", set.join(", "));
     }
     let images = match model.node_constant {
         0.0 => "off (node constant 0)".to_string(),

@@ -84,7 +84,7 @@ pub fn preset_defaults(command: clap::Command) -> clap::Command {
 type Field = fn(&Defaults) -> String;
 
 /// Each option whose default the preset decides, and where the table holds it.
-const PRESET_DEFAULTS: [(&str, Field); 10] = [
+const PRESET_DEFAULTS: [(&str, Field); 11] = [
     ("min_image_fraction", |d| {
         d.criteria.min_image_fraction.to_string()
     }),
@@ -105,6 +105,7 @@ const PRESET_DEFAULTS: [(&str, Field); 10] = [
         d.completion.spanning_forests.to_string()
     }),
     ("biconnected", |d| d.biconnected.to_string()),
+    ("pair_mean", |d| d.cost_model.pair_mean.name().to_string()),
     ("min_pair_fitness", |d| {
         d.cost_model.min_pair_fitness.to_string()
     }),

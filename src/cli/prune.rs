@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::{copy, rewrite};
+use vgsel_colmap::costs::Mean;
 use vgsel_colmap::outputs::report::{Outputs, Report};
 use vgsel_colmap::outputs::{export, plots, scores};
 use vgsel_colmap::selection::capture_order::Order;
@@ -122,6 +123,10 @@ pub struct PruneArgs {
     /// weight 0 are computed only for --scores.
     #[arg(long, value_name = "NAME=W,...", value_parser = weights, default_value = "", help_heading = EXPERT)]
     weights: Weights,
+    /// How a pair's priors' fitness make its fitness: every prior must rate a pair well
+    /// (geometric), or a strong one may carry a weak one (arithmetic, the paper's).
+    #[arg(long, value_parser = choice::<Mean>(), help_heading = EXPERT)]
+    pair_mean: Option<Mean>,
     /// Pairs whose fitness (−cost, in [0, 1]) is below this are never selected: a floor that
     /// stops flow paths running from one copy of a duplicated structure to another over
     /// low-ranked pairs. With a searched flow it is lowered until the image criterion's share
@@ -149,6 +154,7 @@ impl PruneArgs {
             spanning_forests: self.spanning_forests,
             biconnected: self.biconnected,
             weights: self.weights.0.clone(),
+            pair_mean: self.pair_mean,
             min_pair_fitness: self.min_pair_fitness,
             min_backbone_tracks: self.min_backbone_tracks,
             order: Some(self.order),

@@ -8,7 +8,7 @@
 
 use crate::check;
 use crate::colmap::database::Database;
-use crate::costs::CostModel;
+use crate::costs::{CostModel, Mean};
 use crate::flow::search::{Criteria, FlowRule, GivenCriteria};
 use crate::named::Named;
 use crate::priors::Prior;
@@ -45,6 +45,8 @@ pub struct Given {
     pub biconnected: Option<bool>,
     /// `--weights`: prior names and weights replacing the preset's.
     pub weights: Vec<(String, f64)>,
+    /// `--pair_mean` (the preset's).
+    pub pair_mean: Option<Mean>,
     /// `--min_pair_fitness` (the preset's).
     pub min_pair_fitness: Option<f64>,
     /// `--min_backbone_tracks` (the preset's).
@@ -122,8 +124,17 @@ impl Parameters {
         let preset = given.preset.unwrap_or(Preset::General);
         let defaults = preset.defaults();
         let mut cost_model = defaults.cost_model;
+        let sequence_window = given.sequence_window.unwrap_or(0);
+        if sequence_window > 0 {
+            for &(prior, w) in &defaults.sequence_weights {
+                cost_model.set_weight(prior.name(), w)?;
+            }
+        }
         for (name, w) in &given.weights {
             cost_model.set_weight(name, *w)?;
+        }
+        if let Some(mean) = given.pair_mean {
+            cost_model.pair_mean = mean;
         }
         if let Some(floor) = given.min_pair_fitness {
             cost_model.min_pair_fitness = floor;
@@ -131,7 +142,6 @@ impl Parameters {
         if let Some(gate) = given.min_backbone_tracks {
             cost_model.min_backbone_tracks = gate;
         }
-        let sequence_window = given.sequence_window.unwrap_or(0);
         if sequence_window > 0
             && !cost_model
                 .pair_priors_to_compute(false)
@@ -442,6 +452,35 @@ mod tests {
         assert_eq!(serde_json::to_value(&two).unwrap(), recorded);
     }
 
+    /// A capture sequence leaves the disambiguation-global preset's cost to backbone_tracks,
+    /// which the window shapes, unless the user weighs the other shares.
+    #[test]
+    fn a_sequence_window_leaves_backbone_tracks_alone_unless_weighed() {
+        let resolve = |window, weights: &[(&str, f64)]| {
+            let given = Given {
+                preset: Some(Preset::DisambiguationGlobal),
+                sequence_window: Some(window),
+                weights: weights.iter().map(|(n, w)| (n.to_string(), *w)).collect(),
+                ..Given::default()
+            };
+            Parameters::resolve(given).unwrap().cost_model
+        };
+        let priors = |model: CostModel| model.pair_priors_to_compute(false);
+        assert_eq!(
+            priors(resolve(0, &[])),
+            [
+                Prior::LoopFraction,
+                Prior::UniqueTracks,
+                Prior::BackboneTracks
+            ]
+        );
+        assert_eq!(priors(resolve(3, &[])), [Prior::BackboneTracks]);
+        assert_eq!(
+            priors(resolve(3, &[("loop_fraction", 1.0)])),
+            [Prior::LoopFraction, Prior::BackboneTracks]
+        );
+    }
+
     /// The preset fills exactly what the user left unset.
     #[test]
     fn given_options_win_over_the_preset() {
@@ -454,6 +493,7 @@ mod tests {
             min_track_observations: Some(40),
             min_pair_fitness: Some(0.3),
             weights: vec![("unique_tracks".into(), 0.5)],
+            pair_mean: Some(Mean::Geometric),
             ..Given::default()
         };
         let p = Parameters::resolve(given).unwrap();
@@ -466,6 +506,7 @@ mod tests {
         assert_eq!(search.completion.spanning_forests, 0);
         assert_eq!(p.cost_model.min_pair_fitness, 0.3);
         assert_eq!(p.cost_model.pair_priors_to_compute(false).len(), 2);
+        assert_eq!(p.cost_model.pair_mean, Mean::Geometric);
         let unknown = Given {
             weights: vec![("nope".into(), 1.0)],
             ..Given::default()
