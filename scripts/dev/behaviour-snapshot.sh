@@ -48,6 +48,8 @@ rm -f gen.db*
 variants=(
   "general|--preset general"
   "disambiguation|--preset disambiguation"
+  "global|--preset disambiguation-global"
+  "global-sequence|--preset disambiguation-global --order name --sequence_window 3 --pair_mean arithmetic"
   "paper|--preset paper-disambiguation --order name"
   "sequence|--preset disambiguation --order name --sequence_window 3 --keep_neighbours 2 --min_pair_fitness 0.5 --weights unique_tracks=0.5"
   "fixed|--flow 30 --min_num_matches 20"
