@@ -187,8 +187,8 @@ fn disambiguation() -> Defaults {
 /// `disambiguation` keeps 6-19, and COLMAP 4.2's global mapper, which averages every pair's
 /// rotation at once, then placed every registered camera right on 9 of 10 matchings measured
 /// (`disambiguation`: one). Not the incremental mappers' preset: its selection is sparser, and
-/// COLMAP 3.8 gained nothing over nine demo matchings, halls, duplicates and streets (495
-/// against 502 cameras right) and lost a 38-image duplicate (38 → 18).
+/// COLMAP 3.8 gained nothing over nine demo matchings, halls, duplicates and streets (595
+/// against 600 cameras right) and lost a 38-image duplicate (38 → 18).
 fn disambiguation_global() -> Defaults {
     let mut defaults = disambiguation();
     for p in &mut defaults.cost_model.pair_priors {
