@@ -307,25 +307,20 @@ fn weighted_fitness(
     let n = fitness.first().map_or(0, |f| f.values.len());
     let mean = (0..n)
         .map(|k| {
-            let present = || {
+            // Weight 0 has no say (and 0 × ln 0 would be NaN).
+            let weighted = || {
                 models
                     .iter()
                     .zip(&fitness)
-                    .filter(move |(_, f)| !f.values[k].is_nan())
+                    .filter(move |(m, f)| m.weight > 0.0 && !f.values[k].is_nan())
+                    .map(move |(m, f)| (m.weight, f.values[k]))
             };
-            let weighted = || present().filter(|(m, _)| m.weight > 0.0);
-            match weighted().map(|(m, _)| m.weight).sum::<f64>() {
+            match weighted().map(|(w, _)| w).sum::<f64>() {
                 w if w <= 0.0 => 0.0,
                 w => match mean {
-                    Mean::Arithmetic => {
-                        weighted().map(|(m, f)| m.weight * f.values[k]).sum::<f64>() / w
-                    }
+                    Mean::Arithmetic => weighted().map(|(v, f)| v * f).sum::<f64>() / w,
                     // exp of the weighted mean log; a fitness of 0 gives -inf, and exp(-inf) 0.
-                    Mean::Geometric => (weighted()
-                        .map(|(m, f)| m.weight * f.values[k].ln())
-                        .sum::<f64>()
-                        / w)
-                        .exp(),
+                    Mean::Geometric => (weighted().map(|(v, f)| v * f.ln()).sum::<f64>() / w).exp(),
                 },
             }
         })

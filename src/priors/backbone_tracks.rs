@@ -34,9 +34,9 @@ use rayon::prelude::*;
 pub const NEIGHBOURS: usize = 3;
 
 /// Share in [0, 1] of each edge's inliers whose two features are on one backbone track (1 for
-/// backbone edges, 0 without inliers).
-pub fn compute(scene: &Scene) -> PriorValues {
-    let backbone = backbone(scene.graph, &strengths(scene), scene.sequence.as_ref());
+/// backbone edges, 0 without inliers); `all` are the tracks of every edge ([`Tracks::all`]).
+pub fn compute(scene: &Scene, all: &Tracks) -> PriorValues {
+    let backbone = backbone(scene.graph, &strengths(scene, all), scene.sequence.as_ref());
     let tracks = Tracks::build(scene, |edge| backbone[edge]);
     let values = (0..scene.graph.edges.len())
         .into_par_iter()
@@ -54,10 +54,9 @@ pub fn compute(scene: &Scene) -> PriorValues {
     }
 }
 
-/// Each edge's strength: its inliers, each weighted by 1 / the images its track (over all
-/// edges) is seen in.
-fn strengths(scene: &Scene) -> Vec<f64> {
-    let all = Tracks::build(scene, |_| true);
+/// Each edge's strength: its inliers, each weighted by 1 / the images its track (`all`, over
+/// every edge) is seen in.
+fn strengths(scene: &Scene, all: &Tracks) -> Vec<f64> {
     (0..scene.graph.edges.len())
         .into_par_iter()
         .map(|edge| {
@@ -188,8 +187,9 @@ mod tests {
             vec![vec![[0.0, 0.0]; 22]; N as usize],
             vec![(100, 100); N as usize],
         );
-        let values = compute(&scene).values;
-        let backbone = backbone(&graph, &strengths(&scene), None);
+        let all = Tracks::all(&scene);
+        let values = compute(&scene, &all).values;
+        let backbone = backbone(&graph, &strengths(&scene, &all), None);
         let mut true_outside_backbone = 0;
         for (edge, e) in graph.edges.iter().enumerate() {
             let ids = (graph.image_ids[e.i as usize], graph.image_ids[e.j as usize]);

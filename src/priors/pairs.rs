@@ -2,6 +2,7 @@
 //! cameras, focal-length estimation and a relative pose per pair; multiple motions also need the
 //! raw matches. [`needs`] tells the pipeline which of those to load into the [`Scene`].
 
+use super::tracks::Tracks;
 use super::values::{Prior, PriorValues};
 use super::{backbone_tracks, triangulation_angle, unique_tracks};
 use super::{context, homography, inliers, loop_consistency, multiple_motions, overlap};
@@ -62,13 +63,17 @@ pub fn compute(scene: &Scene, priors: &[Prior], stage: &dyn Fn(&str)) -> Result<
     if wants(Prior::Overlap) {
         values.push(overlap::compute(scene));
     }
+    // Both track priors read the tracks of every verified pair: followed once, by the first.
+    let mut tracks = None;
     if wants(Prior::UniqueTracks) {
         stage("following tracks");
-        values.push(unique_tracks::compute(scene));
+        let all = tracks.get_or_insert_with(|| Tracks::all(scene));
+        values.push(unique_tracks::compute(scene, all));
     }
     if wants(Prior::BackboneTracks) {
         stage("following tracks through the backbone");
-        values.push(backbone_tracks::compute(scene));
+        let all = tracks.get_or_insert_with(|| Tracks::all(scene));
+        values.push(backbone_tracks::compute(scene, all));
     }
     if wants(Prior::Context) || wants(Prior::ContextHamming) || wants(Prior::ContextOutside) {
         stage("computing context similarity");

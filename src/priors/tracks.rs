@@ -17,6 +17,11 @@ pub struct Tracks {
 }
 
 impl Tracks {
+    /// The tracks made by the inliers of every edge.
+    pub fn all(scene: &Scene) -> Tracks {
+        Tracks::build(scene, |_| true)
+    }
+
     /// The tracks made by the inliers of the edges for which `keep(edge)` holds.
     pub fn build(scene: &Scene, keep: impl Fn(usize) -> bool) -> Tracks {
         let mut offset = Vec::with_capacity(scene.keypoints.len() + 1);

@@ -17,9 +17,9 @@ use crate::scene::Scene;
 /// A track with more observations than this many times the median is confusing.
 pub const CONFUSING_FACTOR: u32 = 4;
 
-/// Share in [0, 1] of each edge's inliers on tracks that are not confusing (0 without inliers).
-pub fn compute(scene: &Scene) -> PriorValues {
-    let tracks = Tracks::build(scene, |_| true);
+/// Share in [0, 1] of each edge's inliers on tracks that are not confusing (0 without inliers);
+/// `tracks` are those of every edge ([`Tracks::all`]).
+pub fn compute(scene: &Scene, tracks: &Tracks) -> PriorValues {
     let mut lengths: Vec<u32> = tracks.lengths().collect();
     let limit = if lengths.is_empty() {
         0
@@ -70,7 +70,7 @@ mod tests {
             vec![vec![[0.0, 0.0]; 5]; n as usize],
             vec![(100, 100); n as usize],
         );
-        let v = compute(&scene);
+        let v = compute(&scene, &Tracks::all(&scene));
         for (e, value) in graph.edges.iter().zip(&v.values) {
             let expected = if e.j == e.i + 1 { 2.0 / 3.0 } else { 0.0 };
             assert!((value - expected).abs() < 1e-12, "{e:?}: {value}");
