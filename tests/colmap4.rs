@@ -238,29 +238,46 @@ fn pycolmap_database_prunes_maps_both_ways_and_restores_byte_for_byte() {
     assert_eq!(schema(&pruned), schema(&full));
 }
 
-/// `--preset disambiguation-global` on the demo, matched by each COLMAP: the global mapper,
-/// which ghosts `disambiguation`'s selection in about half of the matchings (10 or 11 of 20
-/// right), places at least 18 of 20 cameras right (every registered camera right on 9 of 10
-/// matchings of the design measured, one wrong on the tenth; docs/priors.md). With
-/// `disambiguation` this failed when written: 11 of 20 right on COLMAP 3.8's matching.
+/// `--preset disambiguation-global` on the demo, matched by each COLMAP: it keeps at most half
+/// the false pairs `disambiguation` keeps (0-1 against 7 when written; 0-3 against 6-19 on nine
+/// matchings of the design, docs/priors.md), its true pairs still reach every image, and COLMAP
+/// 4.2's global mapper registers at least 18 of 20. How many of them it places right is
+/// recorded, not asserted: the global mapper is not deterministic on 2 cores, and on one
+/// pycolmap matching the one false pair left gave 11 of 20 right in one run and 19 in the next
+/// (9 of 10 matchings measured had every registered camera right).
 #[test]
-fn the_global_preset_leaves_the_global_mapper_no_ghost_on_the_demo() {
+fn the_global_preset_keeps_fewer_false_pairs_on_the_demo() {
     let Some(f) = fixture() else { return };
     let tmp = tempfile::tempdir().unwrap();
     for (name, db) in [("pycolmap", &f.db42), ("colmap38", &f.db38)] {
-        let pruned = tmp.path().join(format!("{name}.db"));
-        let args = ["prune", "-q", "--preset", "disambiguation-global"];
-        ok(&[
-            &args[..],
-            &["--database_path", s(db), "--output", s(&pruned)],
-        ]
-        .concat());
+        // (false pairs, pieces of the true pairs) of `preset`'s selection, by the ground truth.
+        let kept = |preset: &str| {
+            let pruned = tmp.path().join(format!("{name}-{preset}.db"));
+            let args = ["prune", "-q", "--preset", preset, "--database_path", s(db)];
+            ok(&[&args[..], &["--output", s(&pruned)]].concat());
+            let gt = s(&f.gt);
+            let args = [
+                "eval",
+                "--model",
+                gt,
+                "--ground_truth",
+                gt,
+                "--database_path",
+            ];
+            let eval: Value =
+                serde_json::from_slice(&ok(&[&args[..], &[s(&pruned)]].concat()).stdout).unwrap();
+            let pairs = &eval["pairs"];
+            let count = |key: &str| pairs[key].as_u64().unwrap();
+            (pruned, count("false"), count("true_graph_components"))
+        };
+        let (_, single, _) = kept("disambiguation");
+        let (pruned, global, pieces) = kept("disambiguation-global");
+        assert!(single >= 3, "{name}: the scene's false pairs ({single})");
+        assert!(2 * global <= single, "{name}: {global} against {single}");
+        assert_eq!(pieces, 1, "{name}");
         let (registered, correct) = map(f, "global", &pruned, &tmp.path().join(name));
-        eprintln!("{name}'s matching: {correct} of {registered} registered right");
-        assert!(
-            correct >= 18,
-            "{name}: {correct} of {registered} registered right"
-        );
+        eprintln!("{name}'s matching: {global} false pairs kept (disambiguation {single}); global mapper {correct} of {registered} registered right");
+        assert!(registered >= 18, "{name}: {registered}");
     }
 }
 
