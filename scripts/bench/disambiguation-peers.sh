@@ -22,15 +22,16 @@
 # environment: DATASETS (default ../shared/datasets), METHODS (runs mapped by COLMAP 3.8),
 #   GLOBAL_METHODS (runs also mapped by COLMAP 4.2's global mapper), each a space-separated list
 #   of: full disambiguation repair (the repair loop after disambiguation: check, prune --model,
-#   one more mapper run where check says ghosted) paper-disambiguation yan-0.30 yan-best
-#   cui-0.50 cui-top3 cui-best calibrator truth (default: all but truth, for both), VARIANTS
+#   one more mapper run where check says ghosted) disambiguation-global paper-disambiguation
+#   yan-0.30 yan-best cui-0.50 cui-top3 cui-best calibrator truth (default: all but truth, for
+#   both), VARIANTS
 #   ("order shuffled")
 # The checkout's Python needs numpy 1.23.5 and friends: a venv at WORKDIR/peers-venv (PyPI).
 # Its package alone is enough (`git archive HEAD disambiguation | tar -x -C DIR`).
 # Oats: its reference cannot judge the link frames; judge its models (WORKDIR/oats/measure/
 # sparse_*) with scripts/lab/two-copies.py, as lab-summary.py does.
 set -euo pipefail
-[ $# -ge 2 ] || { sed -n '13,30p' "$0" >&2; exit 2; }
+[ $# -ge 2 ] || { sed -n '13,32p' "$0" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/../.." && pwd)
 peers=$(cd "$1" && pwd)
 mkdir -p "$2"
@@ -39,7 +40,7 @@ shift 2
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(street cup books oats cereal duplicate twin symmetric street-design hall)
 datasets=${DATASETS:-$here/../shared/datasets}
-all="full disambiguation repair paper-disambiguation yan-0.30 yan-best cui-0.50 cui-top3 cui-best calibrator"
+all="full disambiguation repair disambiguation-global paper-disambiguation yan-0.30 yan-best cui-0.50 cui-top3 cui-best calibrator"
 methods=${METHODS:-$all}
 global_methods=${GLOBAL_METHODS:-$all}
 bin=${VGSEL:-$here/target/release/vgsel-colmap}
@@ -75,7 +76,8 @@ rendered() {
 spec() {
   local method=$1 variant=$2 mapper=$3 dir=$4
   case $method in
-    full|disambiguation|repair|paper-disambiguation|truth) echo "$method:$variant:image_id:$mapper" ;;
+    full|disambiguation|repair|disambiguation-global|paper-disambiguation|truth)
+      echo "$method:$variant:image_id:$mapper" ;;
     *) echo "keep=$dir/peers_$variant/keep/$method.txt:$variant:image_id:$mapper" ;;
   esac
 }

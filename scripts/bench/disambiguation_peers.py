@@ -178,6 +178,7 @@ def calibrator(db, out):
 
 METHODS = {"full": "full database", "disambiguation": "`--preset disambiguation`",
            "repair": "`--preset disambiguation` + repair loop",
+           "disambiguation-global": "`--preset disambiguation-global`",
            "paper-disambiguation": "`--preset paper-disambiguation`",
            "keep=yan-0.30": "Yan'17, README (0.30)", "keep=yan-best": "Yan'17, best of sweep",
            "keep=cui-0.50": "Cui'15 v2, notebook (0.50)", "keep=cui-top3": "Cui'15 v2, top 3",
