@@ -132,44 +132,6 @@ fn full_graph_at_flow_e_and_capped_search() {
     }
 }
 
-/// Pairs of cost 0 (a geometric mean of priors scores a pair 0 where one prior does) are ties
-/// the flow need not take: a pair target beyond the pairs of negative cost is capped at their
-/// number, so the search selects about the pairs that scored above 0 instead of the full
-/// graph. With no pair of negative cost nothing ranks them, and the full graph is kept.
-#[test]
-fn zero_cost_pairs_do_not_cap_the_search_at_the_full_graph() {
-    // Image costs 0, as the disambiguation presets have them; every third pair scored 0.
-    let mut p = random_problem(30, 200, 11);
-    p.image_costs.iter_mut().for_each(|c| *c = 0.0);
-    for (k, e) in p.pairs.iter_mut().enumerate() {
-        if k % 3 == 0 {
-            e.cost = 0.0;
-        }
-    }
-    let negative: Vec<bool> = p.pairs.iter().map(|e| e.cost < 0.0).collect();
-    let scored = negative.iter().filter(|&&b| b).count();
-    assert!(scored < 150);
-    // 5 pairs per image ask for 150: more than the scored pairs.
-    let FlowRule::Criteria(c) = criteria(0.8, 5.0) else {
-        unreachable!()
-    };
-    assert_eq!(targets(&p, &c), (24, scored));
-    let r = search(&p, &criteria(0.8, 5.0));
-    assert!(!r.capped, "{:?}", r.criteria);
-    let (_, pairs) = counts(&r.selection);
-    assert!(pairs >= scored && pairs < p.pairs.len(), "{pairs}");
-    assert!(status(&r, "pairs").met);
-    // Mostly the scored pairs, and the smallest such F.
-    let kept_scored = (r.selection.pairs.iter().zip(&negative)).filter(|(&k, &n)| k && n);
-    assert!(kept_scored.count() * 10 >= scored * 9);
-    assert!(counts(&solve(&p, r.selection.flow - 1)).1 < scored);
-
-    // Every pair at 0: the target stays at 150 and the search keeps the full graph.
-    p.pairs.iter_mut().for_each(|e| e.cost = 0.0);
-    assert_eq!(targets(&p, &c), (24, 150));
-    assert!(search(&p, &criteria(0.8, 5.0)).capped);
-}
-
 #[test]
 fn fixed_flow() {
     let p = random_problem(40, 200, 5);

@@ -43,7 +43,7 @@ pub struct FlowArgs {
     /// Search: smallest F selecting at least this fraction of the view graph's images.
     #[arg(long, value_parser = fraction)]
     min_image_fraction: Option<f64>,
-    /// Search: ... and at least this many pairs per image (capped at the pairs scored above 0).
+    /// Search: ... and at least this many pairs per image (capped at all pairs).
     #[arg(long, value_parser = non_negative)]
     min_pairs_per_image: Option<f64>,
     /// Search: ... and at least this fraction of the view graph's pairs.

@@ -5,10 +5,7 @@
 //! exact smallest such F (the paper doubles F and bisects, with one full solve per probe).
 //!
 //! Targets, with n = number of images in the problem: images selected >= ceil(A n) and pairs
-//! selected >= min(max(ceil(B n), ceil(P |E|)), |E-|), E- the pairs of negative cost (all pairs
-//! where none is): a pair of cost 0 is a tie the flow need not take, so a target beyond E- could
-//! keep the search from ever meeting it (a geometric mean of priors scores many pairs 0), and it
-//! would then keep the full graph, every pair it had scored 0 included.
+//! selected >= min(max(ceil(B n), ceil(P |E|)), |E|).
 //!
 //! A caller may add [`SelectionCheck`]s computed from the selected pairs
 //! ([`crate::connectivity::Biconnected`]); they are evaluated
@@ -25,9 +22,8 @@
 //! In practice a search is capped by the image criterion only: with strictly negative costs the
 //! min-cost flow of value |E| is the full graph (every image arc saturated, every pair selected:
 //! dropping a pair loses its cost and one image-arc unit), so the pair target min(ceil(B n), |E|)
-//! is met at the latest at F = |E|; only zero costs (ties) could prevent it, hence the cap at
-//! |E-|. Images without pairs never carry flow, so A n above the number of images with pairs
-//! caps the search at once.
+//! is met at the latest at F = |E|; only zero costs (ties) can prevent it. Images without pairs
+//! never carry flow, so A n above the number of images with pairs caps the search at once.
 
 use crate::network::{Selection, SelectionProblem};
 use crate::solver::ParametricSolver;
@@ -76,7 +72,7 @@ impl GivenCriteria {
 pub struct Criteria {
     /// Selected images / images in the view graph.
     pub min_image_fraction: f64,
-    /// Selected pairs >= this x images in the view graph (capped at the pairs of negative cost).
+    /// Selected pairs >= this x images in the view graph (capped at all pairs).
     pub min_pairs_per_image: f64,
     /// ... and >= this share of all pairs: the paper's criterion for its dense lab scenes
     /// (about 25% of the edges); 0 for the others.
@@ -135,13 +131,7 @@ pub fn targets(problem: &SelectionProblem, criteria: &Criteria) -> (usize, usize
     let m = problem.pairs.len();
     let per_image = (criteria.min_pairs_per_image * n).ceil().max(0.0) as usize;
     let fraction = (criteria.min_pair_fraction * m as f64).ceil().max(0.0) as usize;
-    // With no pair of negative cost nothing ranks the pairs: the target stays reachable only by
-    // the full graph, which the search then keeps.
-    let negative = match problem.pairs.iter().filter(|p| p.cost < 0.0).count() {
-        0 => m,
-        k => k,
-    };
-    let pairs = per_image.max(fraction).min(negative);
+    let pairs = per_image.max(fraction).min(m);
     (images, pairs)
 }
 
