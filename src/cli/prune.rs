@@ -131,7 +131,7 @@ pub struct PruneArgs {
     /// stops flow paths running from one copy of a duplicated structure to another over
     /// low-ranked pairs. With a searched flow it is lowered until the image criterion's share
     /// of images keep a pair above it that the selection may use (not one forbidden, or blamed
-    /// by --model).
+    /// by --model); without --model never as far as the pairs scored 0.
     #[arg(long, value_parser = fraction, help_heading = EXPERT)]
     min_pair_fitness: Option<f64>,
     /// Pairs whose backbone_tracks share (of their inliers, those that chains of matches

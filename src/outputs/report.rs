@@ -56,7 +56,7 @@ pub struct Report {
     /// The inliers those pairs lost.
     pub matches_dropped: usize,
     /// The fitness floor applied: the cost model's `min_pair_fitness`, lowered (with a
-    /// searched flow) until the image criterion's number of images keep a pair reaching it.
+    /// searched flow) as far as the criteria need ([`crate::selection::arc_rules::fitness_floor`]).
     pub fitness_floor: f64,
     /// Edges never offered to the flow: fitness below `fitness_floor`.
     pub pairs_below_fitness_floor: usize,

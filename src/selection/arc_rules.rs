@@ -426,13 +426,15 @@ pub fn remove_below(
 /// pair low (real photos where few triangles close within the loop tolerance) a fixed floor
 /// left the flow too few pairs for `colmap mapper` to start a model (docs/priors.md); so did a
 /// floor that counted the pairs a ghosted model blamed, where they were most of those above it
-/// (the twin design, docs/check.md). With a fixed flow it is applied as given.
+/// (the twin design, docs/check.md). It falls to 0 only under `zero`'s rule. With a fixed
+/// flow it is applied as given.
 pub fn fitness_floor(
     floor: f64,
     rule: &FlowRule,
     graph: &ViewGraph,
     rules: &[ArcRule],
     pair_costs: &[f64],
+    zero: ZeroFitness,
 ) -> f64 {
     let FlowRule::Criteria(criteria) = rule else {
         return floor;
@@ -463,8 +465,30 @@ pub fn fitness_floor(
     }
     let images = (criteria.min_image_fraction * n as f64).ceil() as usize;
     let pairs = (criteria.min_pairs_per_image * n as f64 / 2.0).ceil() as usize;
-    let fitness = usable().map(|(_, fitness)| fitness).collect();
-    floor.min(kth(best, images)).min(kth(fitness, pairs))
+    let fitness: Vec<f64> = usable().map(|(_, fitness)| fitness).collect();
+    let lowered = floor
+        .min(kth(best, images))
+        .min(kth(fitness.clone(), pairs));
+    let lowest_scored = fitness.into_iter().filter(|&f| f > 0.0).reduce(f64::min);
+    match (zero, lowest_scored) {
+        (ZeroFitness::Out, Some(lowest)) if lowered <= 0.0 => lowest,
+        _ => lowered,
+    }
+}
+
+/// Whether a lowered [`fitness_floor`] may let in the pairs the priors score 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ZeroFitness {
+    /// Never: a pair scored 0 has nothing for it, and where such pairs are most of the graph
+    /// (`disambiguation-global`'s geometric mean on a twin matching: 151 of 237 pairs, 54 of
+    /// them false) letting them in left a search that could not meet its pair target, which
+    /// then kept every pair. A plain prune; where no pair scores above 0 the floor is 0 anyway.
+    Out,
+    /// Yes: with `--model` the check has taken out the pairs that glued a mapper run's copies,
+    /// and the pairs it left are what the next turn rebuilds from (the twin's turn from its
+    /// full model: every one of the 151 left, 17 of 18 cameras right, the bound; only the 75
+    /// scored above 0: 14 of 15).
+    In,
 }
 
 #[cfg(test)]
@@ -672,7 +696,8 @@ mod tests {
         // The disambiguation preset's floor.
         let preset = 0.6;
         let free = [ArcRule::Free; 4];
-        let floor = |rule: FlowRule| fitness_floor(preset, &rule, &graph, &free, &costs);
+        let floor =
+            |rule: FlowRule| fitness_floor(preset, &rule, &graph, &free, &costs, ZeroFitness::Out);
         // Best pair per image: 0.9, 0.9, 0.8, 0.2, 0.1. Three images reach the preset's floor
         // (0.6) already, and half of 0.4 pairs per image x 5 images is one pair.
         assert_eq!(floor(rule(0.6, 0.4, None)), preset);
@@ -692,7 +717,32 @@ mod tests {
             ArcRule::Free,
             ArcRule::Free,
         ];
-        let floor = fitness_floor(preset, &rule(0.6, 0.4, None), &graph, &blamed, &costs);
-        assert_eq!(floor, 0.2);
+        let floor =
+            |zero| fitness_floor(preset, &rule(0.6, 0.4, None), &graph, &blamed, &costs, zero);
+        assert_eq!(floor(ZeroFitness::Out), 0.2);
+    }
+
+    #[test]
+    fn a_plain_prune_never_lowers_the_floor_to_pairs_scored_zero() {
+        // A path 1-2-3-4-5: pair fitnesses 0.9, 0, 0, 0.5; every image wanted. Image 3 has only
+        // pairs scored 0, so meeting the image criterion would need the floor at 0.
+        let images = images(5);
+        let pairs: Vec<VerifiedPair> = (1..5).map(|a| pair(a, a + 1, vec![[0, 0]; 20])).collect();
+        let graph = ViewGraph::build(&images, &pairs, 15);
+        let rule = FlowRule::Criteria(Criteria {
+            min_image_fraction: 1.0,
+            min_pairs_per_image: 0.0,
+            min_pair_fraction: 0.0,
+            min_pairs_each: 0.0,
+        });
+        let free = [ArcRule::Free; 4];
+        let floor = |costs: &[f64], zero| fitness_floor(0.6, &rule, &graph, &free, costs, zero);
+        let costs = [-0.9, 0.0, 0.0, -0.5];
+        // Without model evidence it stops at the lowest pair scored above 0 ...
+        assert_eq!(floor(&costs, ZeroFitness::Out), 0.5);
+        // ... with it, at 0.
+        assert_eq!(floor(&costs, ZeroFitness::In), 0.0);
+        // Where no pair scores above 0 nothing ranks them: 0 either way.
+        assert_eq!(floor(&[0.0; 4], ZeroFitness::Out), 0.0);
     }
 }

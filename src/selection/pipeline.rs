@@ -16,7 +16,7 @@ use crate::priors::pairs::FocalEstimate;
 use crate::priors::{self, Prior, PriorValues};
 use crate::scene::view_graph::ViewGraph;
 use crate::scene::{Scene, Sequence};
-use crate::selection::arc_rules::{self, ArcRules, Listed, Overrides, Resolved};
+use crate::selection::arc_rules::{self, ArcRules, Listed, Overrides, Resolved, ZeroFitness};
 use crate::selection::capture_order::{self, CaptureOrder};
 use crate::selection::parameters::{Flow, Parameters};
 use crate::selection::preset::Preset;
@@ -288,12 +288,17 @@ fn apply_arc_rules(
     let neighbours_kept = arc_rules::keep_neighbours(&mut edges, graph, order, window);
     let model = &parameters.cost_model;
     let rule = parameters.flow.rule();
+    let zero = match parameters.arc_rules.model.is_empty() {
+        true => ZeroFitness::Out,
+        false => ZeroFitness::In,
+    };
     let floor = arc_rules::fitness_floor(
         model.min_pair_fitness,
         &rule,
         graph,
         &edges,
         &costs.pair_costs,
+        zero,
     );
     let fitness = costs.pair_costs.iter().map(|c| -c);
     let below_fitness_floor = arc_rules::remove_below(&mut edges, fitness, floor);
