@@ -237,7 +237,7 @@ impl Report {
             .find(|c| c.binding)
             .map(|c| c.name.as_str());
         let why = match (self.capped, binding) {
-            (true, _) => "no flow met the criteria: full graph kept".to_string(),
+            (true, _) => "no flow met the criteria: every pair the network offers kept".to_string(),
             (false, Some(name)) => format!("set by the {name} criterion"),
             (false, None) => "fixed by --flow".to_string(),
         };
