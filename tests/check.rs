@@ -224,6 +224,52 @@ fn the_repair_loop_from_the_twins_full_model_leaves_no_ghost() {
     assert_ne!(answer.trim(), "pruned", "no turn was taken");
     assert!(eval["correct"].as_u64().unwrap() >= 16, "{eval}");
     assert!(!truth_ghosted(&eval), "{eval}");
+    global_preset_selects_only_scored_pairs(&work.join("full.db"));
+}
+
+/// `--preset disambiguation-global` on the twin's full database: its geometric mean scores most
+/// pairs 0 there (one of three priors at 0), and the prune must still select by the scores, not
+/// keep every pair because no flow met its pair target among them (session 36's mend: the
+/// fitness floor never falls to pairs scored 0 without `--model`).
+fn global_preset_selects_only_scored_pairs(db: &Path) {
+    let dir = db.parent().unwrap();
+    let (report, scores) = (dir.join("global.json"), dir.join("global.csv"));
+    let out = vgsel(&[
+        "prune",
+        "-q",
+        "--dry_run",
+        "--database_path",
+        db.to_str().unwrap(),
+        "--preset",
+        "disambiguation-global",
+        "--report",
+        report.to_str().unwrap(),
+        "--scores",
+        scores.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let value: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(value["capped"], false, "{}", value["criteria"]);
+    let csv = std::fs::read_to_string(&scores).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (cost, kept) = (column("cost"), column("kept"));
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let zero = rows
+        .iter()
+        .filter(|r| r[cost].parse::<f64>().unwrap() >= 0.0);
+    let zero_kept = zero.clone().filter(|r| r[kept] == "1").count();
+    eprintln!(
+        "disambiguation-global on the twin: {} of {} pairs kept, {} scored 0, {zero_kept} of them kept",
+        value["pairs_selected"],
+        rows.len(),
+        zero.count()
+    );
+    assert_eq!(zero_kept, 0);
 }
 
 /// The symmetric orbit (24 images, one sequence in name order), full and pruned, COLMAP 3.8:
