@@ -465,11 +465,11 @@ pub fn fitness_floor(
     }
     let images = (criteria.min_image_fraction * n as f64).ceil() as usize;
     let pairs = (criteria.min_pairs_per_image * n as f64 / 2.0).ceil() as usize;
-    let fitness: Vec<f64> = usable().map(|(_, fitness)| fitness).collect();
+    let fitness = usable().map(|(_, fitness)| fitness);
+    let lowest_scored = fitness.clone().filter(|&f| f > 0.0).reduce(f64::min);
     let lowered = floor
         .min(kth(best, images))
-        .min(kth(fitness.clone(), pairs));
-    let lowest_scored = fitness.into_iter().filter(|&f| f > 0.0).reduce(f64::min);
+        .min(kth(fitness.collect(), pairs));
     match (zero, lowest_scored) {
         (ZeroFitness::Out, Some(lowest)) if lowered <= 0.0 => lowest,
         _ => lowered,
