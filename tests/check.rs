@@ -134,6 +134,26 @@ fn check_with(model: &Path, db: &Path, more: &[&str], left: &Path) -> Output {
     vgsel(&args)
 }
 
+/// Every check's verdict lines in a pipeline's `work` folder (`check_VARIANT.txt`), in the
+/// order of the runs (full, pruned, repaired1, ...): what a failed loop assertion shows.
+fn check_lines(work: &Path) -> Vec<String> {
+    let mut checks: Vec<(String, String)> = std::fs::read_dir(work)
+        .unwrap()
+        .filter_map(|e| {
+            let path = e.unwrap().path();
+            let name = path.file_name()?.to_str()?.to_string();
+            let variant = name
+                .strip_prefix("check_")?
+                .strip_suffix(".txt")?
+                .to_string();
+            Some((variant, std::fs::read_to_string(&path).unwrap()))
+        })
+        .collect();
+    let rank = |v: &str| ["full", "pruned"].iter().position(|x| *x == v).unwrap_or(2);
+    checks.sort_by(|(a, _), (b, _)| (rank(a), a).cmp(&(rank(b), b)));
+    checks.into_iter().map(|(_, text)| text).collect()
+}
+
 /// The rendered scene `kind` (`num_images`, seed 1) in a temporary folder, run through
 /// `scripts/pipeline.sh` with COLMAP 3.8 and `REPAIR=repair` turns of the loop into its `work`
 /// folder ([`run_pipeline`]): the folder and the pipeline's work folder.
@@ -221,9 +241,10 @@ fn the_repair_loop_from_the_twins_full_model_leaves_no_ghost() {
         eval["correct"],
         eval["registered"]
     );
+    let checks = check_lines(&work).join("");
     assert_ne!(answer.trim(), "pruned", "no turn was taken");
-    assert!(eval["correct"].as_u64().unwrap() >= 16, "{eval}");
-    assert!(!truth_ghosted(&eval), "{eval}");
+    assert!(eval["correct"].as_u64().unwrap() >= 16, "{checks}{eval}");
+    assert!(!truth_ghosted(&eval), "{checks}{eval}");
     global_preset_selects_only_scored_pairs(&work.join("full.db"));
 }
 
@@ -639,15 +660,7 @@ fn the_repair_loop_makes_one_correct_model_of_the_halls_two_orbits() {
     // The loop's answer: its last run the check calls clean (else its last run).
     let answer = std::fs::read_to_string(work.join("answer")).unwrap();
     let last = read(&format!("eval_{}.json", answer.trim())).unwrap();
-    let checks: Vec<String> = std::fs::read_dir(&work)
-        .unwrap()
-        .filter_map(|e| {
-            let path = e.unwrap().path();
-            let name = path.file_name()?.to_str()?.to_string();
-            (name.starts_with("check_") && name.ends_with(".txt"))
-                .then(|| std::fs::read_to_string(&path).unwrap())
-        })
-        .collect();
+    let checks = check_lines(&work);
     eprintln!("after {turns} turns, {answer}: {last}\n{}", checks.join(""));
     // The checks' `repair` is what the next turn's prune acts on, pair for pair: each folder's
     // lists in the order given (the full model first where it is ghosted), each pair once.
@@ -757,11 +770,12 @@ fn the_loop_with_colmap4s_global_mapper_repairs_the_hall_too(dir: &Path) {
         last["registered"],
         last["models"]
     );
+    let checks = check_lines(&work).join("");
     assert_eq!(
         truth_ghosted(&pruned),
         answer.trim() != "pruned",
-        "{pruned}"
+        "{checks}{pruned}"
     );
-    assert!(last["models"].as_u64().unwrap() <= 2, "{last}");
-    assert_eq!(last["correct"], 38, "{last}");
+    assert!(last["models"].as_u64().unwrap() <= 2, "{checks}{last}");
+    assert_eq!(last["correct"], 38, "{checks}{last}");
 }
