@@ -191,18 +191,22 @@ pub fn check_model<'e>(
     let pairs = evidence.map(|e| &e.pairs);
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
-    let candidates = candidates(&views, &covisibility, settings);
-    let groups = candidates.as_slice();
+    let (mut candidates, signed) = candidates(&views, &covisibility, settings);
     let reach = conflict::Reach::new(&views, &settings.conflict);
-    let scored: Vec<(Vec<bool>, Counts)> = groups
-        .par_iter()
-        .map(|side| {
-            let counts = conflict::count(&views, &reach, side, &settings.conflict);
-            (side.clone(), counts)
-        })
-        .collect();
+    let score_all = |sides: &[Vec<bool>]| -> Vec<(Vec<bool>, Counts)> {
+        (sides.par_iter())
+            .map(|side| {
+                let counts = conflict::count(&views, &reach, side, &settings.conflict);
+                (side.clone(), counts)
+            })
+            .collect()
+    };
+    let mut scored = score_all(candidates.as_slice());
+    // The best few, each refined by its links' own conflicts, are candidates too.
+    let refined = refined_splits(&scored, &signed, &mut candidates, settings);
+    scored.extend(score_all(&refined));
+    let mut splits_scored = scored.len();
     let mut worst = worst_split(scored.into_iter(), settings);
-    let mut splits_scored = groups.len();
     // An image registered alone onto the other copy (a street's camera one building off) is no
     // split of groups; where no such split is ghosted, each image alone is scored too.
     if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
@@ -358,6 +362,30 @@ fn unanchored(views: &Views) -> Vec<String> {
     names
 }
 
+/// Scored splits whose refinement ([`splits::refine`]) is tried: the best by score.
+const REFINED: usize = 5;
+
+/// The [`REFINED`] best of the `scored` splits, each refined by the `signed` links
+/// ([`splits::refine`]), where that gives a split `candidates` lacks (added to it).
+fn refined_splits(
+    scored: &[(Vec<bool>, Counts)],
+    signed: &[(f64, usize, usize)],
+    candidates: &mut splits::SplitList,
+    settings: &CheckSettings,
+) -> Vec<Vec<bool>> {
+    let mut best: Vec<&(Vec<bool>, Counts)> = scored.iter().collect();
+    best.sort_by(|x, y| score(&y.1, settings).total_cmp(&score(&x.1, settings)));
+    let mut out = Vec::new();
+    for (side, _) in best.into_iter().take(REFINED) {
+        let side = splits::normalised(splits::refine(side, signed, settings.min_group));
+        if !candidates.contains(&side) {
+            candidates.push(side.clone());
+            out.push(side);
+        }
+    }
+    out
+}
+
 /// The verdict on a split's counts: its score reaches the threshold, on enough conflicts.
 fn is_ghost(counts: &Counts, settings: &CheckSettings) -> bool {
     score(counts, settings) >= settings.threshold && counts.conflicting >= settings.min_conflicts
@@ -394,7 +422,7 @@ fn candidates(
     views: &Views,
     covisibility: &splits::Covisibility,
     settings: &CheckSettings,
-) -> splits::SplitList {
+) -> (splits::SplitList, Vec<(f64, usize, usize)>) {
     let n = views.views.len();
     let links = covisibility.links();
     let pairs: Vec<Counts> = links
@@ -415,6 +443,11 @@ fn candidates(
         })
         .map(|(l, _)| *l)
         .collect();
+    // Each link's conflicting samples less its agreeing ones: what the best splits are refined
+    // by (`splits::refine`).
+    let signed = (links.iter().zip(&pairs))
+        .map(|(&(_, a, b), c)| (c.conflicting as f64 - c.agreeing as f64, a, b))
+        .collect();
     let min = settings.min_group;
     let spectral = splits::spectral_splits(n, &agreeing, min);
     let components = splits::component_splits(n, &agreeing, min);
@@ -429,7 +462,7 @@ fn candidates(
     {
         out.push(side);
     }
-    out
+    (out, signed)
 }
 
 fn describe(

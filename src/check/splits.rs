@@ -266,6 +266,48 @@ pub fn component_splits(
     out.into_vec()
 }
 
+/// `side` moved one view at a time to the other side while that raises the signed weight the
+/// split cuts (each link's weight counts for the split where the link crosses it, against it
+/// where it does not), each time the view that raises it most, both sides kept at `min_group`
+/// views at least. With a link's conflicting samples less its agreeing ones as weight, a split
+/// that cuts a copy in two is pulled to the copies' own: two copies seen from the same spots
+/// conflict across the ghost and agree within each copy, where a spanning tree's cut follows
+/// the strongest co-visibility, which crosses between them (the twin's orbits, 13 against 20
+/// images where they are 16 and 17; docs/check.md).
+pub fn refine(side: &[bool], signed: &[(f64, usize, usize)], min_group: usize) -> Vec<bool> {
+    let n = side.len();
+    let mut side = side.to_vec();
+    let mut adjacent: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    for &(w, a, b) in signed {
+        adjacent[a].push((b, w));
+        adjacent[b].push((a, w));
+    }
+    // What moving `v` adds to the cut: links that cross become uncut, and the others cut.
+    let gain = |side: &[bool], v: usize| -> f64 {
+        (adjacent[v].iter())
+            .map(|&(u, w)| if side[u] == side[v] { w } else { -w })
+            .sum()
+    };
+    let mut sizes = [side.iter().filter(|s| !**s).count(), 0];
+    sizes[1] = n - sizes[0];
+    // Every move raises the cut's weight, so no split comes back; the bound is a guard.
+    for _ in 0..n * n {
+        let best = (0..n)
+            .filter(|&v| sizes[usize::from(side[v])] > min_group)
+            .map(|v| (gain(&side, v), v))
+            .max_by(|x, y| x.0.total_cmp(&y.0).then(y.1.cmp(&x.1)));
+        match best {
+            Some((g, v)) if g > 0.0 => {
+                sizes[usize::from(side[v])] -= 1;
+                side[v] = !side[v];
+                sizes[usize::from(side[v])] += 1;
+            }
+            _ => break,
+        }
+    }
+    side
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -294,5 +336,40 @@ mod tests {
         });
         assert_eq!(weakest_link_split(9, &links, 3), groups);
         assert_eq!(weakest_link_split(9, &links, 5), None);
+    }
+
+    /// Two copies of four views that pair up view by view (0 with 4, ...) as a ghost's do:
+    /// within a copy the links agree (weight -10), between the paired views they conflict
+    /// (+10), and views 1 and 5 share one agreeing link (-2). From a split that cuts each copy
+    /// in two, the refinement reaches the copies, the one split that cuts every conflicting
+    /// link and no agreeing one within a copy; brute force over every split says no other cuts
+    /// more weight. A refined split keeps `min_group` views a side, and the copies stay.
+    #[test]
+    fn refinement_pulls_a_split_to_the_copies() {
+        let mut signed = Vec::new();
+        for first in [0, 4] {
+            for a in first..first + 4 {
+                signed.extend((a + 1..first + 4).map(|b| (-10.0, a, b)));
+            }
+        }
+        signed.extend((0..4).map(|a| (10.0, a, a + 4)));
+        signed.push((-2.0, 1, 5));
+        let copies = vec![false, false, false, false, true, true, true, true];
+        let cut = |side: &[bool]| -> f64 {
+            (signed.iter())
+                .filter(|(_, a, b)| side[*a] != side[*b])
+                .map(|(w, _, _)| w)
+                .sum()
+        };
+        let best = (1..256u32)
+            .map(|bits| (0..8).map(|v| bits >> v & 1 == 1).collect::<Vec<bool>>())
+            .max_by(|x, y| cut(x).total_cmp(&cut(y)))
+            .unwrap();
+        assert_eq!(normalised(best), copies);
+        let mixed = [false, false, true, true, false, false, true, true];
+        assert_eq!(normalised(refine(&mixed, &signed, 3)), copies);
+        assert_eq!(refine(&copies, &signed, 3), copies);
+        // With four views a side required, no view may leave a side of four.
+        assert_eq!(refine(&mixed, &signed, 4), mixed);
     }
 }
