@@ -417,7 +417,9 @@ const PAIR_MAX_RATIO: f64 = 0.4;
 /// The candidate splits of both spanning trees: of the co-visibility graph, and of the same
 /// graph with each link weakened by its own conflict ratio (two copies seen from the same spot
 /// share the repeated object's points, so co-visibility alone links them strongly; what they
-/// see around it conflicts).
+/// see around it conflicts); and the components and spectral cuts of the links that agree.
+/// With them, each link weighed by its own conflicts (conflicting less agreeing samples), by
+/// which [`refined_splits`] refines the best of them.
 fn candidates(
     views: &Views,
     covisibility: &splits::Covisibility,
