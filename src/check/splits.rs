@@ -288,8 +288,8 @@ pub fn refine(side: &[bool], signed: &[(f64, usize, usize)], min_group: usize) -
             .map(|&(u, w)| if side[u] == side[v] { w } else { -w })
             .sum()
     };
-    let mut sizes = [side.iter().filter(|s| !**s).count(), 0];
-    sizes[1] = n - sizes[0];
+    let first = side.iter().filter(|s| !**s).count();
+    let mut sizes = [first, n - first];
     // Every move raises the cut's weight, so no split comes back; the bound is a guard.
     for _ in 0..n * n {
         let best = (0..n)
