@@ -143,3 +143,16 @@ def loop_runs(work):
         variant = os.path.basename(ev)[len("eval_"):-len(".json")]
         yield (f"{loop}/sparse_{variant}", f"{loop}/{variant}.db", f"{loop}/full.db",
                f"{work}/scene/gt", ev)
+
+
+def pipeline_runs(top):
+    """(model folder, its database, eval report) of every run of every scripts/pipeline.sh work
+    folder under `top`, at any depth (one with an `eval_full.json`): full, pruned and
+    repairedK, each where its database is there and its mapper made a model."""
+    for full in sorted(glob.glob(f"{top}/**/eval_full.json", recursive=True)):
+        work = os.path.dirname(full)
+        for ev in sorted(glob.glob(f"{work}/eval_*.json")):
+            variant = os.path.basename(ev)[len("eval_"):-len(".json")]
+            model, db = f"{work}/sparse_{variant}", f"{work}/{variant}.db"
+            if os.path.exists(db) and os.path.isdir(model) and os.listdir(model):
+                yield model, db, ev

@@ -3,10 +3,13 @@
 what a change to the check does to verdicts it gave before (docs/check.md, "One image on the
 wrong copy", "A misplaced group", "Unanchored images").
 
-Three kinds of work folder, as the lab scripts leave them:
+Four kinds of work folder, as the scripts leave them:
   --loops DIR ...   scripts/lab/repair-loop.sh's: every run of each loop (the full, pruned and
                     repaired models, each with its database and eval); truth: every registered
                     camera correct
+  --pipelines DIR ...  every scripts/pipeline.sh work folder found under each DIR (an
+                    `eval_full.json` beside `full.db`): each run's model with its database and
+                    eval (ground truth given to the pipeline); truth as for --loops
   --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned and (GLOBAL=1)
                     global/sparse_full, global/sparse_pruned per scene with their databases;
                     truth: SUB.eval.json's, per sub-model, "unknown" without ground truth
@@ -15,10 +18,12 @@ Three kinds of work folder, as the lab scripts leave them:
 Prints one row per model folder (set, truth, exit status, verdict lines), then per set the
 counts of truth by verdict (exit status 0 clean, 3 wrong), and per sub-model the images
 the check calls unanchored (the report's `unanchored`: on no 3D point, or next to none) by
-truth.
+truth. With --before BINARY (the check before a change), each model is checked by both and
+only the rows whose exit status or scores moved are printed, then the counts by truth, exit
+status before and after.
 
-usage: VGSEL=target/release/vgsel-colmap scripts/lab/recheck.py [--loops DIR ...]
-       [--scenes DIR ...] [--peers WORK]
+usage: VGSEL=target/release/vgsel-colmap scripts/lab/recheck.py [--before BINARY]
+       [--loops DIR ...] [--pipelines DIR ...] [--scenes DIR ...] [--peers WORK]
 """
 import argparse
 import collections
@@ -41,6 +46,12 @@ def models(args):
             e = json.load(open(ev))
             truth = "correct" if e["correct"] == e["registered"] else "wrong"
             yield "loops", truth, model, db
+    for top in args.pipelines:
+        for model, db, ev in colmap_files.pipeline_runs(top):
+            e = json.load(open(ev))
+            if "images" in e:
+                truth = "correct" if e["correct"] == e["registered"] else "wrong"
+                yield "pipelines", truth, model, db
     for work in args.scenes:
         for scene in sorted(glob.glob(f"{work}/*/full.db")):
             d = os.path.dirname(scene)
@@ -73,9 +84,25 @@ def models(args):
                 yield "peers", truth, run["sparse"], peers.database(run)
 
 
+def check(binary, model, db, report):
+    """`binary check` of one model folder: its exit status, verdict lines and report (None
+    where it failed)."""
+    out = subprocess.run([binary, "check", "--model", model, "--database_path", db,
+                          "--report", report], capture_output=True, text=True)
+    ok = out.returncode in (0, 3)
+    return out.returncode, out.stdout.splitlines(), json.load(open(report)) if ok else None
+
+
+def scores(report):
+    """Each sub-model's score, rounded as the verdict line prints it."""
+    return [round(m["score"], 3) for m in report["models"]] if report else None
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--before", help="the vgsel-colmap binary before a change")
     parser.add_argument("--loops", nargs="*", default=[])
+    parser.add_argument("--pipelines", nargs="*", default=[])
     parser.add_argument("--scenes", nargs="*", default=[])
     parser.add_argument("--peers")
     args = parser.parse_args()
@@ -84,20 +111,26 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "check.json")
         for kind, truth, model, db in models(args):
-            out = subprocess.run([VGSEL, "check", "--model", model, "--database_path", db,
-                                  "--report", report], capture_output=True, text=True)
-            print(kind, truth, model, out.returncode, "|", " ; ".join(out.stdout.splitlines()),
-                  flush=True)
-            verdicts[(kind, truth, out.returncode)] += 1
-            if out.returncode in (0, 3):
-                for m in json.load(open(report))["models"]:
-                    unanchored[(truth, bool(m["unanchored"]))] += 1
-    print("\nset, truth, exit status (0 clean, 3 wrong): models")
+            status, lines, after = check(VGSEL, model, db, report)
+            if args.before:
+                before_status, _, before = check(args.before, model, db, report)
+                verdicts[(kind, truth, before_status, status)] += 1
+                if (before_status, scores(before)) != (status, scores(after)):
+                    print(kind, truth, model, before_status, scores(before), "->", status,
+                          scores(after), "|", " ; ".join(lines), flush=True)
+                continue
+            print(kind, truth, model, status, "|", " ; ".join(lines), flush=True)
+            verdicts[(kind, truth, status)] += 1
+            for m in after["models"] if after else []:
+                unanchored[(truth, bool(m["unanchored"]))] += 1
+    statuses = "before and after " if args.before else ""
+    print(f"\nset, truth, exit status {statuses}(0 clean, 3 wrong): models")
     for key, n in sorted(verdicts.items()):
         print(*key, n)
-    print("\ntruth, some image unanchored: sub-models")
-    for key, n in sorted(unanchored.items()):
-        print(*key, n)
+    if unanchored:
+        print("\ntruth, some image unanchored: sub-models")
+        for key, n in sorted(unanchored.items()):
+            print(*key, n)
 
 
 if __name__ == "__main__":
