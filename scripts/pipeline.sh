@@ -42,7 +42,8 @@
 #                   seconds (README); a run whose mapper makes no model (COLMAP 3.8 found no
 #                   initial pair: an outcome, recorded as such) ends the loop, the model
 #                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
-#                   loop_answer) is its last run the check calls clean, else its last run
+#                   loop_answer) is its last run the check calls clean (not the pruned run
+#                   where the full model's evidence came first), else its last run
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 # This checkout, or the package's copy of its scripts (/usr/share/vgsel-colmap, run as
@@ -222,7 +223,9 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
     --report "$work/check_$last.json" >"$work/check_$last.txt" || status=$?
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
-  [ "$status" = 0 ] && answer=$last
+  # A clean verdict answers, but the pruned run's where the full model's ghost came first:
+  # there it is that ghost hidden (the twin's, every one at hand).
+  [ "$status" = 0 ] && { [ "$last" != pruned ] || [ -z "$full_evidence" ]; } && answer=$last
   { [ "$turn" = 1 ] && [ -n "$full_evidence" ]; } ||
     python3 -c 'import json, sys; sys.exit(not any(json.load(open(sys.argv[1]))["repair"].values()))' \
       "$work/check_$last.json" || break
