@@ -362,21 +362,22 @@ fn unanchored(views: &Views) -> Vec<String> {
     names
 }
 
-/// Scored splits whose refinement ([`splits::refine`]) is tried: the best by score.
+/// Scored splits whose refinement ([`splits::refine`]) is tried: the worst.
 const REFINED: usize = 5;
 
-/// The [`REFINED`] best of the `scored` splits, each refined by the `signed` links
-/// ([`splits::refine`]), where that gives a split `candidates` lacks (added to it).
+/// The [`REFINED`] worst of the `scored` splits (by [`badness`], as [`worst_split`]), each
+/// refined by the `signed` links ([`splits::refine`]), where that gives a split `candidates`
+/// lacks (added to it).
 fn refined_splits(
     scored: &[(Vec<bool>, Counts)],
     signed: &[(f64, usize, usize)],
     candidates: &mut splits::SplitList,
     settings: &CheckSettings,
 ) -> Vec<Vec<bool>> {
-    let mut best: Vec<&(Vec<bool>, Counts)> = scored.iter().collect();
-    best.sort_by(|x, y| score(&y.1, settings).total_cmp(&score(&x.1, settings)));
+    let mut worst: Vec<&(Vec<bool>, Counts)> = scored.iter().collect();
+    worst.sort_by(|x, y| badness(&y.1, &x.1, settings));
     let mut out = Vec::new();
-    for (side, _) in best.into_iter().take(REFINED) {
+    for (side, _) in worst.into_iter().take(REFINED) {
         let side = splits::normalised(splits::refine(side, signed, settings.min_group));
         if !candidates.contains(&side) {
             candidates.push(side.clone());
@@ -391,16 +392,25 @@ fn is_ghost(counts: &Counts, settings: &CheckSettings) -> bool {
     score(counts, settings) >= settings.threshold && counts.conflicting >= settings.min_conflicts
 }
 
+/// How split counts `a` compare with `b` in badness: enough conflicts to be judged first, then
+/// the score.
+fn badness(a: &Counts, b: &Counts, settings: &CheckSettings) -> std::cmp::Ordering {
+    let judged = |c: &Counts| c.conflicting >= settings.min_conflicts;
+    (judged(a).cmp(&judged(b))).then(score(a, settings).total_cmp(&score(b, settings)))
+}
+
 /// The worst of the `scored` splits: the highest score among those with enough conflicts to be
 /// judged, else the highest score (reported, never ghosted).
 fn worst_split(
     scored: impl Iterator<Item = (Vec<bool>, Counts)>,
     settings: &CheckSettings,
 ) -> Option<(Vec<bool>, Counts)> {
-    let rank = |c: &Counts| (c.conflicting >= settings.min_conflicts, score(c, settings));
     let mut worst: Option<(Vec<bool>, Counts)> = None;
     for (side, counts) in scored {
-        if worst.as_ref().is_none_or(|w| rank(&counts) > rank(&w.1)) {
+        if worst
+            .as_ref()
+            .is_none_or(|w| badness(&counts, &w.1, settings).is_gt())
+        {
             worst = Some((side, counts));
         }
     }

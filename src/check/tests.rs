@@ -1442,3 +1442,32 @@ fn images_with_verified_pairs_and_no_model_are_lost_even_where_a_prune_left_them
     assert_eq!(evidence.unregistered(&models, 15), ["0013.png"]);
     assert_eq!(evidence.lost(&models, 15), ["0013.png", "0014.png"]);
 }
+
+#[test]
+fn the_splits_refined_are_the_worst_judged_first() {
+    let settings = DEFAULT_SETTINGS;
+    let counts = |conflicting: usize, agreeing: usize| Counts {
+        conflicting,
+        agreeing,
+        matched: 0,
+        seen: 0,
+    };
+    // Five splits with too few conflicts to be judged, each scoring above a sixth that has
+    // enough: the sixth is the worst split, and so among the five refined.
+    let few = settings.min_conflicts - 1;
+    let split = |k: usize| (0..8).map(|i| i == 0 || i == k).collect::<Vec<bool>>();
+    let mut scored: Vec<(Vec<bool>, Counts)> =
+        (1..=5).map(|k| (split(k), counts(few, 0))).collect();
+    let judged = (split(6), counts(settings.min_conflicts, 2000));
+    assert!(score(&scored[0].1, &settings) > score(&judged.1, &settings));
+    scored.push(judged);
+    let worst = worst_split(scored.clone().into_iter(), &settings).unwrap();
+    assert_eq!(worst.0, split(6));
+    let mut candidates = splits::SplitList::default();
+    let refined = refined_splits(&scored, &[], &mut candidates, &settings);
+    assert_eq!(refined.len(), super::REFINED);
+    assert!(
+        refined.contains(&splits::normalised(split(6))),
+        "{refined:?}"
+    );
+}
