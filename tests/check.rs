@@ -276,10 +276,9 @@ fn the_global_loop_never_answers_with_the_twins_hidden_ghost(dir: &Path) {
         eval["registered"]
     );
     assert!(checks.contains("sparse_full/0: GHOSTED"), "{checks}");
-    let prune: Value = serde_json::from_str(
-        &std::fs::read_to_string(work.join("prune_repaired1.json")).unwrap(),
-    )
-    .unwrap();
+    let prune: Value =
+        serde_json::from_str(&std::fs::read_to_string(work.join("prune_repaired1.json")).unwrap())
+            .unwrap();
     let first = prune["parameters"]["model"][0].as_str().unwrap();
     assert!(first.ends_with("sparse_full"), "{first}: {checks}");
     assert_ne!(answer.trim(), "pruned", "{checks}");
