@@ -176,6 +176,30 @@ fn run_pipeline(dir: &Path, work: &str, env: &[(&str, &str)]) -> PathBuf {
     work
 }
 
+/// A JSON file's value.
+fn json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The first run's loop again from its matched database (`DATABASE=dir/work/full.db`, as a
+/// user starts from a database already matched), with COLMAP 4.2's global mapper
+/// (`MAPPER=global`, through pycolmap) and `REPAIR=3`, into `dir/global`: that work folder, the
+/// pruned run's eval, the loop's answer and the answer's eval.
+fn global_loop(dir: &Path) -> (PathBuf, Value, String, Value) {
+    let database = dir.join("work/full.db");
+    let env = [
+        ("REPAIR", "3"),
+        ("MAPPER", "global"),
+        ("DATABASE", database.to_str().unwrap()),
+    ];
+    let work = run_pipeline(dir, "global", &env);
+    let (pruned, _, _) = variant_run(&work, "pruned");
+    let answer = std::fs::read_to_string(work.join("answer")).unwrap();
+    let answer = answer.trim().to_string();
+    let (eval, _, _) = variant_run(&work, &answer);
+    (work, pruned, answer, eval)
+}
+
 #[test]
 fn check_agrees_with_the_ground_truth_on_the_rendered_duplicate_scene() {
     let (dir, work) = pipeline(SceneKind::Duplicate, 20, 0);
@@ -256,32 +280,17 @@ fn the_repair_loop_from_the_twins_full_model_leaves_no_ghost() {
 /// flagged (unanchored) or not, is the answer.
 /// About 15 s more.
 fn the_global_loop_never_answers_with_the_twins_hidden_ghost(dir: &Path) {
-    let database = dir.join("work/full.db");
-    let env = [
-        ("REPAIR", "3"),
-        ("MAPPER", "global"),
-        ("DATABASE", database.to_str().unwrap()),
-    ];
-    let work = run_pipeline(dir, "global", &env);
+    let (work, pruned, answer, eval) = global_loop(dir);
     let checks = check_lines(&work).join("");
-    let (pruned, _, _) = variant_run(&work, "pruned");
-    let answer = std::fs::read_to_string(work.join("answer")).unwrap();
-    let (eval, _, _) = variant_run(&work, answer.trim());
     eprintln!(
-        "global mapper: pruned {} of {}; the loop's answer, {}: {} of {}",
-        pruned["correct"],
-        pruned["registered"],
-        answer.trim(),
-        eval["correct"],
-        eval["registered"]
+        "global mapper: pruned {} of {}; the loop's answer, {answer}: {} of {}",
+        pruned["correct"], pruned["registered"], eval["correct"], eval["registered"]
     );
     assert!(checks.contains("sparse_full/0: GHOSTED"), "{checks}");
-    let prune: Value =
-        serde_json::from_str(&std::fs::read_to_string(work.join("prune_repaired1.json")).unwrap())
-            .unwrap();
+    let prune = json(&work.join("prune_repaired1.json"));
     let first = prune["parameters"]["model"][0].as_str().unwrap();
     assert!(first.ends_with("sparse_full"), "{first}: {checks}");
-    assert_ne!(answer.trim(), "pruned", "{checks}");
+    assert_ne!(answer, "pruned", "{checks}");
 }
 
 /// `--preset disambiguation-global` on the twin's full database: its geometric mean scores most
@@ -775,13 +784,7 @@ fn the_repair_loop_makes_one_correct_model_of_the_halls_two_orbits() {
 fn the_loop_with_colmap4s_global_mapper_repairs_the_hall_too(dir: &Path) {
     let matched = dir.join("work/full.db");
     let before = std::fs::read(&matched).unwrap();
-    let database = matched.to_str().unwrap();
-    let env = [
-        ("REPAIR", "3"),
-        ("MAPPER", "global"),
-        ("DATABASE", database),
-    ];
-    let work = run_pipeline(dir, "global", &env);
+    let (work, pruned, answer, last) = global_loop(dir);
     assert!(
         std::fs::read(&matched).unwrap() == before,
         "the matched database changed"
@@ -799,21 +802,14 @@ fn the_loop_with_colmap4s_global_mapper_repairs_the_hall_too(dir: &Path) {
     for db in ["full.db", "pruned.db"] {
         assert_eq!(user_version(&work.join(db)), 3800, "{db} migrated");
     }
-    let (pruned, _, _) = variant_run(&work, "pruned");
-    let answer = std::fs::read_to_string(work.join("answer")).unwrap();
-    let (last, _, _) = variant_run(&work, answer.trim());
     eprintln!(
-        "global mapper: pruned {} of 38 right; the loop's answer, {}: {} of {} in {} models",
-        pruned["correct"],
-        answer.trim(),
-        last["correct"],
-        last["registered"],
-        last["models"]
+        "global mapper: pruned {} of 38 right; the loop's answer, {answer}: {} of {} in {} models",
+        pruned["correct"], last["correct"], last["registered"], last["models"]
     );
     let checks = check_lines(&work).join("");
     assert_eq!(
         truth_ghosted(&pruned),
-        answer.trim() != "pruned",
+        answer != "pruned",
         "{checks}{pruned}"
     );
     if last["correct"] == 38 && last["models"].as_u64().unwrap() <= 2 {
@@ -821,10 +817,7 @@ fn the_loop_with_colmap4s_global_mapper_repairs_the_hall_too(dir: &Path) {
     }
     // The global mapper's own misses: an answer short of that is one the check does not call
     // clean (the user is told), and better than the preset's selection alone.
-    let check: Value = serde_json::from_str(
-        &std::fs::read_to_string(work.join(format!("check_{}.json", answer.trim()))).unwrap(),
-    )
-    .unwrap();
+    let check = json(&work.join(format!("check_{answer}.json")));
     let flagged = ["ghosted", "misplaced", "folded", "unanchored"]
         .iter()
         .any(|k| check[k] == true);

@@ -24,7 +24,8 @@ class LoopCounts(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             for name, summary in [("a/global", loop), ("b", no_loop), ("c/x/y", false_alarm)]:
                 os.makedirs(os.path.join(d, name))
-                json.dump(summary, open(os.path.join(d, name, "summary.json"), "w"))
+                with open(os.path.join(d, name, "summary.json"), "w") as f:
+                    json.dump(summary, f)
             out = run("loop-counts.py", d).splitlines()
         self.assertEqual(out[2], f"| {d}/a/global | 19/38 ghosted | 28/38 ghosted → 38/38 clean "
                                  "| repaired1: 38/38 clean |")
