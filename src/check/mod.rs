@@ -202,7 +202,7 @@ pub fn check_model<'e>(
             .collect()
     };
     let mut scored = score_all(candidates.as_slice());
-    // The best few, each refined by its links' own conflicts, are candidates too.
+    // The worst few, each refined by its links' own conflicts, are candidates too.
     let refined = refined_splits(&scored, &signed, &mut candidates, settings);
     scored.extend(score_all(&refined));
     let mut splits_scored = scored.len();
@@ -429,7 +429,7 @@ const PAIR_MAX_RATIO: f64 = 0.4;
 /// share the repeated object's points, so co-visibility alone links them strongly; what they
 /// see around it conflicts); and the components and spectral cuts of the links that agree.
 /// With them, each link weighed by its own conflicts (conflicting less agreeing samples), by
-/// which [`refined_splits`] refines the best of them.
+/// which [`refined_splits`] refines the worst of them.
 fn candidates(
     views: &Views,
     covisibility: &splits::Covisibility,
