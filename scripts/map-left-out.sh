@@ -28,7 +28,7 @@ if [ -z "$(ls -A "$sparse" 2>/dev/null)" ]; then
   echo 0
   exit 0
 fi
-# Exit 3 is the model's verdict (ghosted, misplaced or unanchored), not a failure.
+# Exit 3 is the model's verdict (ghosted, misplaced, detached or unanchored), not a failure.
 "$bin" check --model "$sparse" --database_path "$db" --unregistered "$list" >/dev/null ||
   [ $? = 3 ]
 if [ ! -s "$list" ]; then

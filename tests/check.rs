@@ -59,8 +59,10 @@ fn check_exit_statuses_report_and_plots() {
     assert_eq!(value["ghosted"], false);
     assert_eq!(value["misplaced"], false);
     assert_eq!(value["unanchored"], false);
+    assert_eq!(value["detached"], false);
     assert_eq!(value["folded"], false);
     assert_eq!(value["models"][0]["unanchored"], serde_json::json!([]));
+    assert_eq!(value["models"][0]["detached"], serde_json::json!([]));
     assert_eq!(value["models"][0]["misplaced"], Value::Null);
     assert_eq!(value["models"][0]["ghost_placement"], Value::Null);
     assert_eq!(
@@ -818,7 +820,7 @@ fn the_loop_with_colmap4s_global_mapper_repairs_the_hall_too(dir: &Path) {
     // The global mapper's own misses: an answer short of that is one the check does not call
     // clean (the user is told), and better than the preset's selection alone.
     let check = json(&work.join(format!("check_{answer}.json")));
-    let flagged = ["ghosted", "misplaced", "folded", "unanchored"]
+    let flagged = ["ghosted", "misplaced", "folded", "detached", "unanchored"]
         .iter()
         .any(|k| check[k] == true);
     assert!(flagged, "a wrong answer called clean: {checks}{last}");

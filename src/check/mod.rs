@@ -106,6 +106,15 @@ pub struct ModelCheck<'e> {
     /// images are the ghost, not its groups (a street's camera one building off, taken for a
     /// split of 16 against 28 images), and the repair acts on them alone.
     pub ghost_of_images: bool,
+    /// The model's images in parts that share no 3D point with each other, where there are
+    /// two or more (each part's names sorted, the largest part first): where the model put one
+    /// part against the other rests on no structure it holds. An incremental mapper registers
+    /// each image on the points before it, so its models are one part; a global mapper places
+    /// cameras before points, and can keep a part whose tracks to the rest it then dropped
+    /// (the twin's walk, turned a quarter about its boxes; every such model at hand had a
+    /// part wholly wrong, docs/check.md). The model is wrong. Images on no point are in no
+    /// part ([`ModelCheck::unanchored`]).
+    pub detached: Vec<Vec<String>>,
     /// Registered images whose poses rest on (next to) nothing the model holds: no point, or
     /// points for under [`ANCHORED_FRACTION`] of their matched keypoints; in a model without
     /// any point, those the database matched to each other. Sorted.
@@ -137,24 +146,32 @@ pub struct ModelCheck<'e> {
 }
 
 impl ModelCheck<'_> {
-    /// Ghosted, a group of it misplaced, images in it unanchored, or neighbours in the capture
-    /// order held apart: the model is wrong where the check can tell.
+    /// Ghosted, a group of it misplaced, images in it unanchored, in parts that share no
+    /// point, or neighbours in the capture order held apart: the model is wrong where the check
+    /// can tell.
     pub fn wrong(&self) -> bool {
         self.ghosted
             || self.places_elsewhere()
             || !self.unanchored.is_empty()
             || !self.neighbours_apart.is_empty()
+            || !self.detached.is_empty()
     }
 
     /// Each view's group: 0 and 1 the worst split's, then one more per split inside
-    /// ([`ModelCheck::inner`]), whose second group's images take the next number.
+    /// ([`ModelCheck::inner`]), whose second group's images take the next number; for a model
+    /// wrong first by its [`ModelCheck::detached`] parts, each part's index (images on no
+    /// point with the largest).
     pub fn groups(&self) -> Vec<usize> {
-        let mut group: Vec<usize> = self.side.iter().map(|&b| usize::from(b)).collect();
         let names = self
             .views
             .iter()
             .flat_map(|v| v.views.iter().map(|w| &w.name));
         let names: Vec<&String> = names.collect();
+        if !self.detached.is_empty() && !self.ghosted && !self.places_elsewhere() {
+            let part = |name: &String| self.detached.iter().position(|p| p.contains(name));
+            return names.iter().map(|n| part(n).unwrap_or(0)).collect();
+        }
+        let mut group: Vec<usize> = self.side.iter().map(|&b| usize::from(b)).collect();
         for (k, split) in self.inner.iter().enumerate() {
             for (v, name) in names.iter().enumerate() {
                 if split.groups[1].contains(name) {
@@ -250,6 +267,7 @@ pub fn check_model<'e>(
         ghost_placement: None,
         misplaced_images: Vec::new(),
         ghost_of_images: false,
+        detached: detached(&views, &covisibility),
         unanchored: unanchored(&views),
         neighbours_apart,
         refused: Vec::new(),
@@ -331,6 +349,23 @@ fn weakest_link(
         split.score = score(&counts, settings);
         (side, split)
     })
+}
+
+/// The names of each of the model's parts ([`splits::Covisibility::parts`]) where there are
+/// two or more, else none.
+fn detached(views: &Views, covisibility: &splits::Covisibility) -> Vec<Vec<String>> {
+    let parts = covisibility.parts();
+    if parts.len() < 2 {
+        return Vec::new();
+    }
+    let name = |v: usize| views.views[v].name.clone();
+    (parts.into_iter())
+        .map(|p| {
+            let mut names: Vec<String> = p.into_iter().map(name).collect();
+            names.sort();
+            names
+        })
+        .collect()
 }
 
 /// An image is anchored by 3D points for at least this fraction of its keypoints that the

@@ -40,6 +40,24 @@ impl Covisibility {
             .collect()
     }
 
+    /// The views that observe some point, in groups that share no point with each other:
+    /// the connected components of the co-visibility graph, each in view order, the largest
+    /// first (ties by first view).
+    pub fn parts(&self) -> Vec<Vec<usize>> {
+        let n = self.seen.len();
+        let mut sets = Sets::new(n);
+        for &(a, b) in self.shared.keys() {
+            sets.union(a, b);
+        }
+        let mut parts: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+        for v in (0..n).filter(|&v| self.seen[v] > 0) {
+            parts.entry(sets.find(v)).or_default().push(v);
+        }
+        let mut parts: Vec<Vec<usize>> = parts.into_values().collect();
+        parts.sort_by(|x, y| y.len().cmp(&x.len()).then(x[0].cmp(&y[0])));
+        parts
+    }
+
     /// The link's strength: shared points over the smaller view's points, in [0, 1].
     pub fn strength(&self, a: usize, b: usize) -> f64 {
         let key = (a.min(b), a.max(b));

@@ -467,6 +467,43 @@ fn an_image_registered_without_a_point_is_unanchored() {
     assert!(!check.ghosted && check.wrong());
 }
 
+/// Images whose points no other part of the model observes (a global mapper's part whose
+/// tracks to the rest it dropped) make the model wrong, each part named; the correct model,
+/// and one image on no point, are one part.
+#[test]
+fn parts_that_share_no_point_are_detached() {
+    let mut model = correct_model();
+    assert!(check_model(&model, None, &DEFAULT_SETTINGS)
+        .unwrap()
+        .detached
+        .is_empty());
+    // The last four images see the same wall, but through points of their own.
+    let own = |id: u64| id + 100_000;
+    for image in &mut model.images[8..] {
+        for p in &mut image.points2d {
+            p.point3d_id = p.point3d_id.map(own);
+        }
+    }
+    let copies: Vec<(u64, [f64; 3])> = model.points.iter().map(|(&id, &p)| (own(id), p)).collect();
+    model.points.extend(copies);
+    model.images[4]
+        .points2d
+        .iter_mut()
+        .for_each(|p| p.point3d_id = None);
+    let check = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
+    let names = |ids: &[u32]| {
+        ids.iter()
+            .map(|k| format!("{k:04}.png"))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        check.detached,
+        [names(&[1, 2, 3, 4, 6, 7, 8]), names(&[9, 10, 11, 12])]
+    );
+    assert_eq!(check.unanchored, ["0005.png"]);
+    assert!(check.wrong());
+}
+
 /// With the database, an image whose model keeps points for under 3% of its matched keypoints
 /// is unanchored too (here 1 in 100 of its keypoints); with 1 in 20 (5% or more of those
 /// matched) it is not.
@@ -965,7 +1002,9 @@ fn a_group_the_database_places_elsewhere_is_misplaced() {
         let c = &run.models[0];
         assert!(!c.ghosted, "score {}", c.score);
         assert_eq!(c.misplaced.is_some(), misplaced, "{:?}", c.misplaced);
-        assert_eq!(c.wrong(), misplaced);
+        assert_eq!(c.places_elsewhere(), misplaced);
+        // The two models put together keep their own tracks: two parts, whatever the placement.
+        assert_eq!(c.detached.len(), 2);
         if let Some(m) = &c.misplaced {
             assert_eq!(m.models, [0, 0]);
             assert!(

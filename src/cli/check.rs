@@ -95,7 +95,7 @@ impl CheckArgs {
 }
 
 /// A model's verdict in a word: what is wrong with it first (ghosted, then misplaced, then
-/// folded onto itself against the capture order, then unanchored), or clean.
+/// folded onto itself against the capture order, then detached, then unanchored), or clean.
 fn verdict(c: &ModelCheck) -> &'static str {
     if c.ghosted {
         "ghosted"
@@ -103,6 +103,8 @@ fn verdict(c: &ModelCheck) -> &'static str {
         "misplaced"
     } else if !c.neighbours_apart.is_empty() {
         "folded"
+    } else if !c.detached.is_empty() {
+        "detached"
     } else if !c.unanchored.is_empty() {
         "unanchored"
     } else {
@@ -184,6 +186,21 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
             "; {n} pair{} of images next in the capture order held as two surfaces, e.g. {}",
             if n == 1 { "" } else { "s" },
             examples(c.neighbours_apart.iter().map(|[a, b]| (a, b)))
+        );
+    }
+    if let [largest, rest @ ..] = c.detached.as_slice() {
+        let sizes: Vec<String> = c.detached.iter().map(|p| p.len().to_string()).collect();
+        line += &format!(
+            "; {} parts that share no 3D point, of {} images; apart from the {}: {}",
+            c.detached.len(),
+            sizes.join(" and "),
+            largest.len(),
+            rest.iter()
+                .flatten()
+                .take(3)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(" ")
         );
     }
     if !c.unanchored.is_empty() {
@@ -387,7 +404,8 @@ fn read_inputs(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<Inp
     })
 }
 
-/// Runs the check; Ok(true) when some model is wrong (ghosted, misplaced or unanchored).
+/// Runs the check; Ok(true) when some model is wrong (ghosted, misplaced, folded, detached or
+/// unanchored).
 /// `quiet` silences the note on stderr; `progress` shows the stages (a large model's check
 /// takes minutes).
 pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
@@ -416,6 +434,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
     let ghosted = run.models.iter().any(|c| c.ghosted);
     let misplaced = run.models.iter().any(ModelCheck::places_elsewhere);
     let unanchored = run.models.iter().any(|c| !c.unanchored.is_empty());
+    let detached = run.models.iter().any(|c| !c.detached.is_empty());
     let folded = run.models.iter().any(|c| !c.neighbours_apart.is_empty());
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
@@ -448,6 +467,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             "ghosted": ghosted,
             "misplaced": misplaced,
             "unanchored": unanchored,
+            "detached": detached,
             "folded": folded,
             "settings": settings,
             "models": reports,
@@ -529,6 +549,26 @@ mod tests {
         );
         assert!(
             line.ends_with("; 2 images registered on (next to) no 3D point: 0019.png 0020.png)"),
+            "{line}"
+        );
+    }
+
+    /// Parts that share no point make the verdict, ahead of unanchored images; the parts but
+    /// the largest are named.
+    #[test]
+    fn detached_parts_are_named() {
+        let mut c = checked(2, 100);
+        c.unanchored = vec!["0019.png".into()];
+        let names = |ids: std::ops::Range<usize>| ids.map(|k| format!("{k:04}.png")).collect();
+        c.detached = vec![names(0..6), names(6..10), names(10..11)];
+        let line = verdict_line(Path::new("sparse/0"), &c, 30);
+        assert!(line.starts_with("sparse/0: DETACHED (score 0.00"), "{line}");
+        assert!(
+            line.ends_with(
+                "; 3 parts that share no 3D point, of 6 and 4 and 1 images; apart from the 6: \
+                 0006.png 0007.png 0008.png; 1 image registered on (next to) no 3D point: \
+                 0019.png)"
+            ),
             "{line}"
         );
     }
