@@ -1510,3 +1510,30 @@ fn the_splits_refined_are_the_worst_judged_first() {
         "{refined:?}"
     );
 }
+
+/// Among ghosted splits the one with the most conflicts beyond its agreements is judged, not
+/// the highest score (a few images where two copies meet); where none is ghosted, the worst.
+#[test]
+fn the_split_judged_is_the_ghost_with_the_most_net_conflicts() {
+    let settings = DEFAULT_SETTINGS;
+    let counts = |conflicting: usize, agreeing: usize| Counts {
+        conflicting,
+        agreeing,
+        matched: 0,
+        seen: 0,
+    };
+    let split = |k: usize| (0..8).map(|i| i < k).collect::<Vec<bool>>();
+    let junction = (split(1), counts(8163, 5432));
+    let copies = (split(4), counts(16163, 12008));
+    let clean = (split(2), counts(100, 5000));
+    assert!(score(&junction.1, &settings) > score(&copies.1, &settings));
+    assert!(is_ghost(&junction.1, &settings) && is_ghost(&copies.1, &settings));
+    let scored = vec![clean.clone(), junction.clone(), copies.clone()];
+    assert_eq!(judged_split(scored.clone(), &settings).unwrap().0, copies.0);
+    assert_eq!(
+        worst_split(scored.into_iter(), &settings).unwrap().0,
+        junction.0
+    );
+    let none = vec![clean.clone(), (split(3), counts(300, 900))];
+    assert_eq!(judged_split(none, &settings).unwrap().0, split(3));
+}
