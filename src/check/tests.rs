@@ -449,6 +449,11 @@ fn the_views_that_can_judge_a_point_are_found_by_distance_as_by_brute_force() {
     }
 }
 
+/// `image` keeps its keypoints, none of them on a 3D point.
+fn observe_no_point(image: &mut SparseImage) {
+    image.points2d.iter_mut().for_each(|p| p.point3d_id = None);
+}
+
 /// An image registered without observing any 3D point makes the model wrong, named; the
 /// correct model has none.
 #[test]
@@ -458,10 +463,7 @@ fn an_image_registered_without_a_point_is_unanchored() {
         .unwrap()
         .unanchored
         .is_empty());
-    model.images[4]
-        .points2d
-        .iter_mut()
-        .for_each(|p| p.point3d_id = None);
+    observe_no_point(&mut model.images[4]);
     let check = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
     assert_eq!(check.unanchored, ["0005.png"]);
     assert!(!check.ghosted && check.wrong());
@@ -486,10 +488,7 @@ fn parts_that_share_no_point_are_detached() {
     }
     let copies: Vec<(u64, [f64; 3])> = model.points.iter().map(|(&id, &p)| (own(id), p)).collect();
     model.points.extend(copies);
-    model.images[4]
-        .points2d
-        .iter_mut()
-        .for_each(|p| p.point3d_id = None);
+    observe_no_point(&mut model.images[4]);
     let check = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
     let names = |ids: &[u32]| {
         ids.iter()
@@ -1482,15 +1481,19 @@ fn images_with_verified_pairs_and_no_model_are_lost_even_where_a_prune_left_them
     assert_eq!(evidence.lost(&models, 15), ["0013.png", "0014.png"]);
 }
 
-#[test]
-fn the_splits_refined_are_the_worst_judged_first() {
-    let settings = DEFAULT_SETTINGS;
-    let counts = |conflicting: usize, agreeing: usize| Counts {
+/// A split's counts: `conflicting` and `agreeing` samples, none matched.
+fn counts(conflicting: usize, agreeing: usize) -> Counts {
+    Counts {
         conflicting,
         agreeing,
         matched: 0,
         seen: 0,
-    };
+    }
+}
+
+#[test]
+fn the_splits_refined_are_the_worst_judged_first() {
+    let settings = DEFAULT_SETTINGS;
     // Five splits with too few conflicts to be judged, each scoring above a sixth that has
     // enough: the sixth is the worst split, and so among the five refined.
     let few = settings.min_conflicts - 1;
@@ -1516,12 +1519,6 @@ fn the_splits_refined_are_the_worst_judged_first() {
 #[test]
 fn the_split_judged_is_the_ghost_with_the_most_net_conflicts() {
     let settings = DEFAULT_SETTINGS;
-    let counts = |conflicting: usize, agreeing: usize| Counts {
-        conflicting,
-        agreeing,
-        matched: 0,
-        seen: 0,
-    };
     let split = |k: usize| (0..8).map(|i| i < k).collect::<Vec<bool>>();
     let junction = (split(1), counts(8163, 5432));
     let copies = (split(4), counts(16163, 12008));
