@@ -177,6 +177,13 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
             line += &placement_text(m);
         }
     }
+    line + &images_text(c) + ")"
+}
+
+/// What the verdict line says of a model's images apart from its split: those placed
+/// elsewhere, neighbours in the capture order held apart, detached parts, unanchored images.
+fn images_text(c: &ModelCheck) -> String {
+    let mut line = String::new();
     for m in &c.misplaced_images {
         line += &misplaced_image_text(m);
     }
@@ -216,7 +223,7 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
                 .join(" ")
         );
     }
-    line + ")"
+    line
 }
 
 /// Where the database's matches place one image, and the pairs for and against it.
