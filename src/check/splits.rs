@@ -44,14 +44,10 @@ impl Covisibility {
     /// the connected components of the co-visibility graph, each in view order, the largest
     /// first (ties by first view).
     pub fn parts(&self) -> Vec<Vec<usize>> {
-        let n = self.seen.len();
-        let mut sets = Sets::new(n);
-        for &(a, b) in self.shared.keys() {
-            sets.union(a, b);
-        }
+        let roots = Sets::roots(self.seen.len(), self.shared.keys().copied());
         let mut parts: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-        for v in (0..n).filter(|&v| self.seen[v] > 0) {
-            parts.entry(sets.find(v)).or_default().push(v);
+        for v in (0..roots.len()).filter(|&v| self.seen[v] > 0) {
+            parts.entry(roots[v]).or_default().push(v);
         }
         let mut parts: Vec<Vec<usize>> = parts.into_values().collect();
         parts.sort_by(|x, y| y.len().cmp(&x.len()).then(x[0].cmp(&y[0])));
@@ -81,6 +77,16 @@ impl Sets {
         let (ra, rb) = (self.find(a), self.find(b));
         self.0[ra.max(rb)] = ra.min(rb);
         ra != rb
+    }
+
+    /// Each of `n` views' representative (its component's smallest view) once every pair of
+    /// `pairs` is joined.
+    pub(super) fn roots(n: usize, pairs: impl IntoIterator<Item = (usize, usize)>) -> Vec<usize> {
+        let mut sets = Sets::new(n);
+        for (a, b) in pairs {
+            sets.union(a, b);
+        }
+        (0..n).map(|v| sets.find(v)).collect()
     }
 
     /// The representative of `a`'s set.
@@ -269,11 +275,7 @@ pub fn component_splits(
     edges: &[(f64, usize, usize)],
     min_group: usize,
 ) -> Vec<Vec<bool>> {
-    let mut sets = Sets::new(n);
-    for &(_, a, b) in edges {
-        sets.union(a, b);
-    }
-    let roots: Vec<usize> = (0..n).map(|v| sets.find(v)).collect();
+    let roots = Sets::roots(n, edges.iter().map(|&(_, a, b)| (a, b)));
     let mut out = SplitList::default();
     for root in 0..n {
         let side: Vec<bool> = roots.iter().map(|&r| r == root).collect();
