@@ -269,7 +269,7 @@ def verdict(variant):
         c = json.load(open(f"{work}/check_{variant}.json"))
     except FileNotFoundError:
         return "-"
-    return next((k for k in ("ghosted", "misplaced", "folded", "detached", "unanchored") if c.get(k)), "clean")
+    return c["verdict"]
 
 
 rows = {}

@@ -145,16 +145,64 @@ pub struct ModelCheck<'e> {
     pub views: Option<Views<'e>>,
 }
 
+/// A model's verdict in a word: what is wrong with it first, in this order, or clean (last,
+/// so the worst of several models is the least). One list for the verdict line, the JSON
+/// report and the scripts that read it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// The worst split conflicts ([`ModelCheck::ghosted`]).
+    Ghosted,
+    /// The database's matches place a group or an image elsewhere
+    /// ([`ModelCheck::places_elsewhere`]).
+    Misplaced,
+    /// Neighbours in the capture order held apart ([`ModelCheck::neighbours_apart`]).
+    Folded,
+    /// Parts that share no 3D point ([`ModelCheck::detached`]).
+    Detached,
+    /// Images on (next to) no 3D point ([`ModelCheck::unanchored`]).
+    Unanchored,
+    /// Nothing the check can tell is wrong.
+    Clean,
+}
+
+impl Verdict {
+    /// The word, as the JSON report spells it.
+    pub fn word(self) -> &'static str {
+        match self {
+            Verdict::Ghosted => "ghosted",
+            Verdict::Misplaced => "misplaced",
+            Verdict::Folded => "folded",
+            Verdict::Detached => "detached",
+            Verdict::Unanchored => "unanchored",
+            Verdict::Clean => "clean",
+        }
+    }
+}
+
 impl ModelCheck<'_> {
+    /// What is wrong with the model first ([`Verdict`]).
+    pub fn verdict(&self) -> Verdict {
+        if self.ghosted {
+            Verdict::Ghosted
+        } else if self.places_elsewhere() {
+            Verdict::Misplaced
+        } else if !self.neighbours_apart.is_empty() {
+            Verdict::Folded
+        } else if !self.detached.is_empty() {
+            Verdict::Detached
+        } else if !self.unanchored.is_empty() {
+            Verdict::Unanchored
+        } else {
+            Verdict::Clean
+        }
+    }
+
     /// Ghosted, a group of it misplaced, images in it unanchored, in parts that share no
     /// point, or neighbours in the capture order held apart: the model is wrong where the check
     /// can tell.
     pub fn wrong(&self) -> bool {
-        self.ghosted
-            || self.places_elsewhere()
-            || !self.unanchored.is_empty()
-            || !self.neighbours_apart.is_empty()
-            || !self.detached.is_empty()
+        self.verdict() != Verdict::Clean
     }
 
     /// Each view's group: 0 and 1 the worst split's, then one more per split inside

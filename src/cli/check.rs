@@ -7,7 +7,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use vgsel_colmap::check::evidence::Evidence;
 use vgsel_colmap::check::resection::Rejoin;
-use vgsel_colmap::check::{self, CheckSettings, ModelCheck, DEFAULT_SETTINGS};
+use vgsel_colmap::check::{self, CheckSettings, ModelCheck, Verdict, DEFAULT_SETTINGS};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
 use vgsel_colmap::colmap::sparse::{read_sparse_model, SparseModel};
@@ -94,24 +94,6 @@ impl CheckArgs {
     }
 }
 
-/// A model's verdict in a word: what is wrong with it first (ghosted, then misplaced, then
-/// folded onto itself against the capture order, then detached, then unanchored), or clean.
-fn verdict(c: &ModelCheck) -> &'static str {
-    if c.ghosted {
-        "ghosted"
-    } else if c.places_elsewhere() {
-        "misplaced"
-    } else if !c.neighbours_apart.is_empty() {
-        "folded"
-    } else if !c.detached.is_empty() {
-        "detached"
-    } else if !c.unanchored.is_empty() {
-        "unanchored"
-    } else {
-        "clean"
-    }
-}
-
 /// Model `k`'s top view (`dir`'s, checked as `result`) into `plots` as `top_view_K.svg`.
 fn plot(plots: &Path, k: usize, dir: &Path, result: &ModelCheck) -> Result<()> {
     let Some(views) = &result.views else {
@@ -121,7 +103,7 @@ fn plot(plots: &Path, k: usize, dir: &Path, result: &ModelCheck) -> Result<()> {
     let title = format!(
         "{}: {} (score {:.2})",
         dir.display(),
-        verdict(result),
+        result.verdict().word(),
         result.score
     );
     let path = plots.join(format!("top_view_{k}.svg"));
@@ -131,9 +113,9 @@ fn plot(plots: &Path, k: usize, dir: &Path, result: &ModelCheck) -> Result<()> {
 /// The line a model gets: its verdict, score and groups; a clean model whose worst split had
 /// fewer judged samples than `min_conflicts` says so, as no ghost could have been found there.
 fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
-    let what = match verdict(c) {
-        "clean" => "clean".to_string(),
-        wrong => wrong.to_uppercase(),
+    let what = match c.verdict() {
+        Verdict::Clean => "clean".to_string(),
+        wrong => wrong.word().to_uppercase(),
     };
     // A model without points (a failed start) was judged on nothing: no score to give.
     let mut line = match c.points {
@@ -436,6 +418,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
         }
         let mut value = serde_json::to_value(result)?;
         value["model"] = dir.display().to_string().into();
+        value["verdict"] = result.verdict().word().into();
         reports.push(value);
     }
     let ghosted = run.models.iter().any(|c| c.ghosted);
@@ -443,6 +426,9 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
     let unanchored = run.models.iter().any(|c| !c.unanchored.is_empty());
     let detached = run.models.iter().any(|c| !c.detached.is_empty());
     let folded = run.models.iter().any(|c| !c.neighbours_apart.is_empty());
+    // The run's verdict: the first word of the order any model earns.
+    let verdict = run.models.iter().map(ModelCheck::verdict).min();
+    let verdict = verdict.unwrap_or(Verdict::Clean);
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
     let mut joined = Vec::new();
@@ -471,6 +457,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
     }
     if let Some(path) = &args.report {
         let report = serde_json::json!({
+            "verdict": verdict,
             "ghosted": ghosted,
             "misplaced": misplaced,
             "unanchored": unanchored,
@@ -486,7 +473,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    Ok(run.models.iter().any(ModelCheck::wrong))
+    Ok(verdict != Verdict::Clean)
 }
 
 #[cfg(test)]
@@ -578,6 +565,12 @@ mod tests {
             ),
             "{line}"
         );
+        // The run's verdict is the first word of the order any model earns.
+        assert_eq!(c.verdict(), Verdict::Detached);
+        let run = [Verdict::Clean, c.verdict(), Verdict::Unanchored];
+        assert_eq!(run.into_iter().min(), Some(Verdict::Detached));
+        c.ghosted = true;
+        assert_eq!(c.verdict(), Verdict::Ghosted);
     }
 
     /// An image alone in its group is named on the verdict line.
