@@ -12,6 +12,10 @@ pub struct CheckSettings {
     pub min_group: usize,
     /// Conflict ratio from which a split is two copies.
     pub threshold: f64,
+    /// Score under which a placement whose links the repair keeps (a ghost's second group
+    /// placed back, two clean models joined) is taken; one from here up to `threshold` ends
+    /// the search with none taken ([`super::join`]).
+    pub placement_threshold: f64,
     /// Conflicting samples a split needs at least to be called two copies (few samples say
     /// little).
     pub min_conflicts: usize,
@@ -33,6 +37,9 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     },
     min_group: 3,
     threshold: 0.48,
+    // The most the splits of groups in correct models scored (docs/check.md): a placement
+    // above it is no better than a split the check would doubt, and its links are kept.
+    placement_threshold: 0.44,
     min_conflicts: 30,
     prior: 500,
     sequence: false,

@@ -825,6 +825,13 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     };
     let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
     let pair = [(&a, false), (&b, false)];
+    let strict = CheckSettings {
+        placement_threshold: 0.0,
+        ..DEFAULT_SETTINGS
+    };
+    let passed_over =
+        join::join_models(&pair, &evidence, &strict, std::slice::from_ref(&glued)).unwrap();
+    assert!(passed_over.is_empty(), "{passed_over:?}");
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[glued]).unwrap();
     assert_eq!(joins.len(), 1, "{joins:?}");
     assert_eq!(joins[0].refuted, 1);
@@ -995,9 +1002,18 @@ fn a_group_the_database_places_elsewhere_is_misplaced() {
         translation: turned.scale * (turned.rotation * back_from_elsewhere().translation)
             + turned.translation,
     };
-    for (placement, misplaced) in [(back_from_elsewhere(), false), (wrong, true)] {
+    // The placement is the verdict here: the placement threshold does not apply.
+    let strict = CheckSettings {
+        placement_threshold: 0.0,
+        ..DEFAULT_SETTINGS
+    };
+    for (placement, misplaced, settings) in [
+        (back_from_elsewhere(), false, &DEFAULT_SETTINGS),
+        (wrong.clone(), true, &DEFAULT_SETTINGS),
+        (wrong, true, &strict),
+    ] {
         let one = join::put_together(&a, &b, &placement).0;
-        let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+        let run = check_run(&[one], Some(&evidence), settings, &[]).unwrap();
         let c = &run.models[0];
         assert!(!c.ghosted, "score {}", c.score);
         assert_eq!(c.misplaced.is_some(), misplaced, "{:?}", c.misplaced);
@@ -1034,7 +1050,13 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
         translation: back_from_elsewhere().translation - Vector3::new(5.0, 0.0, 0.0),
     };
     let one = join::put_together(&a, &b, &fold).0;
-    let run = check_run(&[one], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+    let run = check_run(
+        std::slice::from_ref(&one),
+        Some(&evidence),
+        &DEFAULT_SETTINGS,
+        &[],
+    )
+    .unwrap();
     let c = &run.models[0];
     assert!(c.ghosted, "score {}", c.score);
     assert!(c.misplaced.is_none());
@@ -1058,8 +1080,16 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
         assert!(ia.abs_diff(ib) != 6, "a twin pair links: {l:?}");
     }
     // The fixture's copies share no 3D point, so nothing is blamed; the links are kept.
-    let evidence = run.evidence();
-    assert_eq!(evidence.links.len(), g.links.len());
+    assert_eq!(run.evidence().links.len(), g.links.len());
+    // Where every placement scores at least the placement threshold, none is taken: the ghost
+    // stays ghosted, and no link is kept.
+    let strict = CheckSettings {
+        placement_threshold: 0.0,
+        ..DEFAULT_SETTINGS
+    };
+    let run = check_run(&[one], Some(&evidence), &strict, &[]).unwrap();
+    assert!(run.models[0].ghosted && run.models[0].ghost_placement.is_none());
+    assert!(run.evidence().links.is_empty());
 }
 
 /// The correct model with image 5 moved `shift` units along the wall, and its matches to

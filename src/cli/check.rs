@@ -57,6 +57,10 @@ pub struct CheckArgs {
     /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = super::args::fraction)]
     threshold: f64,
+    /// Expert: score under which a placement whose links the repair keeps (a ghost's group
+    /// placed back, two clean models joined) is taken; from it up to --threshold, none is.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.placement_threshold, value_parser = super::args::fraction)]
+    placement_threshold: f64,
     /// Expert: largest angle (degrees) between two images' rays for one to be expected to see
     /// what the other saw.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
@@ -83,6 +87,7 @@ impl CheckArgs {
     fn settings(&self) -> CheckSettings {
         let mut s = DEFAULT_SETTINGS;
         s.threshold = self.threshold;
+        s.placement_threshold = self.placement_threshold;
         s.conflict.max_angle_deg = self.max_angle;
         s.conflict.max_scale = self.max_scale.max(1.0);
         s.conflict.radius = self.radius;
