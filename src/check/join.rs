@@ -11,8 +11,9 @@
 //! must score under [`CheckSettings::placement_threshold`]. False matches between copies
 //! propose the placement that folds one copy onto the other, and where they outnumber the true
 //! links (why the mapper glued the copies in the first place) it is the strongest; it
-//! conflicts, and the next placement that does not joins the models. The database pairs it explains are the
-//! links a mapper needs to make one model of the two (`prune --model` keeps them).
+//! conflicts, and the next placement that does not joins the models. The database pairs it
+//! explains are the links a mapper needs to make one model of the two (`prune --model` keeps
+//! them).
 //!
 //! Only after a stronger placement conflicted: where the strongest does not, it may be a ghost
 //! the check cannot see (copies that share their surroundings), and nothing tells it from a
@@ -222,6 +223,7 @@ pub fn join_models(
     earlier: &[Glued],
 ) -> anyhow::Result<Vec<Join>> {
     let mut joins = Vec::new();
+    let below = kept_below(settings);
     let usable = |m: &(&SparseModel, bool)| !m.1 && m.0.images.len() >= settings.min_group;
     for a in 0..models.len() {
         for b in a + 1..models.len() {
@@ -230,7 +232,6 @@ pub fn join_models(
                 let ghosts: Vec<&Glued> = (earlier.iter())
                     .filter(|g| g.between(pair[0], pair[1]))
                     .collect();
-                let below = kept_below(settings);
                 joins.extend(join_two(
                     [a, b],
                     pair,
@@ -274,9 +275,10 @@ pub fn place_group(
     }
     let [a, b] = [&groups[0], &groups[1]].map(|g| subset(model, g));
     let refuted = usize::from(ghosted);
-    let below = match ghosted {
-        true => kept_below(settings),
-        false => settings.threshold,
+    let below = if ghosted {
+        kept_below(settings)
+    } else {
+        settings.threshold
     };
     let Some(join) = join_two([k, k], [&a, &b], evidence, settings, refuted, &[], below)? else {
         return Ok(None);
