@@ -16,6 +16,9 @@ pub struct CheckSettings {
     /// placed back, two clean models joined) is taken; one from here up to `threshold` ends
     /// the search with none taken ([`super::join`]).
     pub placement_threshold: f64,
+    /// With the database: score from which one image alone is ghosted by its conflicts
+    /// alone; under it (from `threshold`), only where its own matches place it elsewhere too.
+    pub alone_threshold: f64,
     /// Conflicting samples a split needs at least to be called two copies (few samples say
     /// little).
     pub min_conflicts: usize,
@@ -40,6 +43,9 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     // The most the splits of groups in correct models scored (docs/check.md): a placement
     // above it is no better than a split the check would doubt, and its links are kept.
     placement_threshold: 0.44,
+    // One image alone in a correct model scored up to 0.53 (five such false alarms, 0.48-0.53,
+    // none placed elsewhere by its matches); docs/check.md.
+    alone_threshold: 0.55,
     min_conflicts: 30,
     prior: 500,
     sequence: false,

@@ -370,6 +370,44 @@ fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
     assert!(blames(&held_apart, false) && !blames(&held_apart, true));
 }
 
+/// An image alone whose own matches place it where the model does (here only its matches to
+/// images 1-4, on the object the model has it see) is ghosted from the threshold for images
+/// alone only; from the threshold for splits where the setting is no higher.
+#[test]
+fn an_image_alone_its_matches_place_where_it_is_needs_the_higher_threshold() {
+    let model = one_image_model(true);
+    let alone = &model.images[12];
+    let mut evidence = Evidence::default();
+    for other in &model.images[..4] {
+        let key = (other.image.name.clone(), alone.image.name.clone());
+        let m = matches_of(other, alone, |id| id);
+        evidence.pairs.insert(key.clone(), m.len());
+        evidence.matches.insert(key, m);
+    }
+    let check = |alone_threshold: f64| {
+        let settings = CheckSettings {
+            alone_threshold,
+            ..DEFAULT_SETTINGS
+        };
+        let run = check_run(
+            std::slice::from_ref(&model),
+            Some(&evidence),
+            &settings,
+            &[],
+        );
+        run.unwrap().models.remove(0)
+    };
+    let strict = check(DEFAULT_SETTINGS.threshold);
+    assert!(strict.ghosted && strict.misplaced_images.is_empty());
+    assert!(strict.worst.as_ref().unwrap().alone());
+    let lenient = check(strict.score + 0.01);
+    assert!(
+        !lenient.ghosted && !lenient.wrong(),
+        "score {}",
+        lenient.score
+    );
+}
+
 /// The one-pass count of an image alone is every sample of that split, brute force over every
 /// point and view (the points the image shares with others included, unlike [`conflict::count`]),
 /// on models with and without a ghost, and with the database's matches.

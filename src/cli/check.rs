@@ -61,6 +61,10 @@ pub struct CheckArgs {
     /// placed back, two clean models joined) is taken; from it up to --threshold, none is.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.placement_threshold, value_parser = super::args::fraction)]
     placement_threshold: f64,
+    /// Expert: with the database, score from which one image alone is ghosted though its own
+    /// matches place it where the model does.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.alone_threshold, value_parser = super::args::fraction)]
+    alone_threshold: f64,
     /// Expert: largest angle (degrees) between two images' rays for one to be expected to see
     /// what the other saw.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
@@ -88,6 +92,7 @@ impl CheckArgs {
         let mut s = DEFAULT_SETTINGS;
         s.threshold = self.threshold;
         s.placement_threshold = self.placement_threshold;
+        s.alone_threshold = self.alone_threshold;
         s.conflict.max_angle_deg = self.max_angle;
         s.conflict.max_scale = self.max_scale.max(1.0);
         s.conflict.radius = self.radius;
@@ -116,8 +121,9 @@ fn plot(plots: &Path, k: usize, dir: &Path, result: &ModelCheck) -> Result<()> {
 }
 
 /// The line a model gets: its verdict, score and groups; a clean model whose worst split had
-/// fewer judged samples than `min_conflicts` says so, as no ghost could have been found there.
-fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
+/// fewer judged samples than `min_conflicts` says so, as no ghost could have been found there,
+/// and one whose image alone scored from the threshold says why it is not ghosted.
+fn verdict_line(dir: &Path, c: &ModelCheck, settings: &CheckSettings) -> String {
     let what = match c.verdict() {
         Verdict::Clean => "clean".to_string(),
         wrong => wrong.word().to_uppercase(),
@@ -137,8 +143,14 @@ fn verdict_line(dir: &Path, c: &ModelCheck, min_conflicts: usize) -> String {
         );
         if let Some(one) = w.groups.iter().find(|g| g.len() == 1) {
             line += &format!(": {} alone", one[0]);
+            if !c.ghosted && c.score >= settings.threshold {
+                line += &format!(
+                    ", which its matches do not place elsewhere: ghosted from {:.2}",
+                    settings.alone_threshold
+                );
+            }
         }
-        if judged < min_conflicts && c.misplaced.is_none() {
+        if judged < settings.min_conflicts && c.misplaced.is_none() {
             line += "; too few samples to find a ghost";
         }
         if let Some(m) = &c.misplaced {
@@ -417,7 +429,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
     progress.finish();
     let mut reports = Vec::new();
     for (k, (dir, result)) in dirs.iter().zip(&run.models).enumerate() {
-        println!("{}", verdict_line(dir, result, settings.min_conflicts));
+        println!("{}", verdict_line(dir, result, &settings));
         if let Some(plots) = &args.plots {
             plot(plots, k, dir, result)?;
         }
@@ -516,7 +528,7 @@ mod tests {
             ..checked(0, 0)
         };
         assert_eq!(
-            verdict_line(Path::new("sparse/0"), &c, 30),
+            verdict_line(Path::new("sparse/0"), &c, &DEFAULT_SETTINGS),
             "sparse/0: UNANCHORED (no 3D point; 2 images registered on (next to) no 3D point: \
              0.png 1.png)"
         );
@@ -526,13 +538,13 @@ mod tests {
     /// enough samples does not.
     #[test]
     fn a_clean_verdict_on_too_few_samples_says_so() {
-        let line = verdict_line(Path::new("sparse/1"), &checked(2, 10), 30);
+        let line = verdict_line(Path::new("sparse/1"), &checked(2, 10), &DEFAULT_SETTINGS);
         assert_eq!(
             line,
             "sparse/1: clean (score 0.00, 2 conflicting of 12 judged; groups of 3 and 3 \
              images; too few samples to find a ghost)"
         );
-        let line = verdict_line(Path::new("sparse/0"), &checked(2, 100), 30);
+        let line = verdict_line(Path::new("sparse/0"), &checked(2, 100), &DEFAULT_SETTINGS);
         assert!(!line.contains("too few"), "{line}");
     }
 
@@ -541,7 +553,7 @@ mod tests {
     fn unanchored_images_are_named() {
         let mut c = checked(2, 100);
         c.unanchored = vec!["0019.png".into(), "0020.png".into()];
-        let line = verdict_line(Path::new("sparse/0"), &c, 30);
+        let line = verdict_line(Path::new("sparse/0"), &c, &DEFAULT_SETTINGS);
         assert!(
             line.starts_with("sparse/0: UNANCHORED (score 0.00"),
             "{line}"
@@ -560,7 +572,7 @@ mod tests {
         c.unanchored = vec!["0019.png".into()];
         let names = |ids: std::ops::Range<usize>| ids.map(|k| format!("{k:04}.png")).collect();
         c.detached = vec![names(0..6), names(6..10), names(10..11)];
-        let line = verdict_line(Path::new("sparse/0"), &c, 30);
+        let line = verdict_line(Path::new("sparse/0"), &c, &DEFAULT_SETTINGS);
         assert!(line.starts_with("sparse/0: DETACHED (score 0.00"), "{line}");
         assert!(
             line.ends_with(
@@ -584,7 +596,7 @@ mod tests {
         let mut c = checked(600, 400);
         c.ghosted = true;
         c.worst.as_mut().unwrap().groups[1] = vec!["0010.png".into()];
-        let line = verdict_line(Path::new("sparse/0"), &c, 30);
+        let line = verdict_line(Path::new("sparse/0"), &c, &DEFAULT_SETTINGS);
         assert!(
             line.contains("groups of 3 and 1 images: 0010.png alone; 0 joining pairs"),
             "{line}"
