@@ -82,7 +82,8 @@ pub struct ModelCheck<'e> {
     pub points: usize,
     /// Candidate splits scored.
     pub splits_scored: usize,
-    /// The verdict: the worst split reaches the threshold with enough conflicts.
+    /// The verdict: the worst split reaches the threshold with enough conflicts (one image
+    /// alone that its matches place where the model does: [`CheckSettings::alone_threshold`]).
     pub ghosted: bool,
     /// The worst split's score (0 without a split).
     pub score: f64,
@@ -754,9 +755,10 @@ pub fn check_run<'e>(
 /// A ghost of one image alone that its own matches do not place elsewhere, scoring under
 /// [`CheckSettings::alone_threshold`]: not ghosted. One image's conflicts are few beside a
 /// group's, and in correct streets an image alone scored 0.48-0.53 five times (each false
-/// alarm cost the loop a turn that blamed a right camera's pairs), where the images alone that
-/// were wrong scored 0.51-0.61 with their matches placing them elsewhere, but one at 0.48
-/// (docs/check.md).
+/// alarm cost the loop a turn that blamed a right camera's pairs), where the wrong images
+/// alone scored 0.51-0.61, most of them placed elsewhere by their matches (one at 0.56 not;
+/// docs/check.md). Such a model is not searched for a misplaced group at its weakest link,
+/// as a model clean from the start is.
 fn alone_unplaced(c: &ModelCheck, settings: &CheckSettings) -> bool {
     let Some(split) = &c.worst else { return false };
     let Some(one) = split.groups.iter().find(|g| g.len() == 1) else {
