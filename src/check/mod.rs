@@ -149,8 +149,7 @@ pub struct ModelCheck<'e> {
 /// A model's verdict in a word: what is wrong with it first, in this order, or clean (last,
 /// so the worst of several models is the least). One list for the verdict line, the JSON
 /// report and the scripts that read it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Verdict {
     /// The worst split conflicts ([`ModelCheck::ghosted`]).
     Ghosted,
@@ -178,6 +177,13 @@ impl Verdict {
             Verdict::Unanchored => "unanchored",
             Verdict::Clean => "clean",
         }
+    }
+}
+
+/// As its [`Verdict::word`], the one spelling of the words.
+impl Serialize for Verdict {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.word())
     }
 }
 

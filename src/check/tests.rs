@@ -370,6 +370,15 @@ fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
     assert!(blames(&held_apart, false) && !blames(&held_apart, true));
 }
 
+/// The default settings but for a placement threshold no placement scores under: every
+/// placement whose links the repair would keep is passed over.
+fn no_placement_taken() -> CheckSettings {
+    CheckSettings {
+        placement_threshold: 0.0,
+        ..DEFAULT_SETTINGS
+    }
+}
+
 /// An image alone whose own matches place it where the model does (here only its matches to
 /// images 1-4, on the object the model has it see) is ghosted from the threshold for images
 /// alone only; from the threshold for splits where the setting is no higher.
@@ -863,10 +872,7 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     };
     let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
     let pair = [(&a, false), (&b, false)];
-    let strict = CheckSettings {
-        placement_threshold: 0.0,
-        ..DEFAULT_SETTINGS
-    };
+    let strict = no_placement_taken();
     let passed_over =
         join::join_models(&pair, &evidence, &strict, std::slice::from_ref(&glued)).unwrap();
     assert!(passed_over.is_empty(), "{passed_over:?}");
@@ -1041,10 +1047,7 @@ fn a_group_the_database_places_elsewhere_is_misplaced() {
             + turned.translation,
     };
     // The placement is the verdict here: the placement threshold does not apply.
-    let strict = CheckSettings {
-        placement_threshold: 0.0,
-        ..DEFAULT_SETTINGS
-    };
+    let strict = no_placement_taken();
     for (placement, misplaced, settings) in [
         (back_from_elsewhere(), false, &DEFAULT_SETTINGS),
         (wrong.clone(), true, &DEFAULT_SETTINGS),
@@ -1121,10 +1124,7 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
     assert_eq!(run.evidence().links.len(), g.links.len());
     // Where every placement scores at least the placement threshold, none is taken: the ghost
     // stays ghosted, and no link is kept.
-    let strict = CheckSettings {
-        placement_threshold: 0.0,
-        ..DEFAULT_SETTINGS
-    };
+    let strict = no_placement_taken();
     let run = check_run(&[one], Some(&evidence), &strict, &[]).unwrap();
     assert!(run.models[0].ghosted && run.models[0].ghost_placement.is_none());
     assert!(run.evidence().links.is_empty());

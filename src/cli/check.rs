@@ -435,7 +435,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
         }
         let mut value = serde_json::to_value(result)?;
         value["model"] = dir.display().to_string().into();
-        value["verdict"] = result.verdict().word().into();
+        value["verdict"] = serde_json::to_value(result.verdict())?;
         reports.push(value);
     }
     let ghosted = run.models.iter().any(|c| c.ghosted);
