@@ -333,15 +333,10 @@ fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
     let misplaced = &model.images[12];
     let mut evidence = Evidence::default();
     for (k, other) in model.images[..12].iter().enumerate() {
-        let m = if k < 4 {
-            matches_of(other, misplaced, |id| id)
-        } else {
-            // A first-wall point to the second wall's point of the same index.
-            matches_of(other, misplaced, |id| id + 10_000)
-        };
-        let key = (other.image.name.clone(), misplaced.image.name.clone());
-        evidence.pairs.insert(key.clone(), m.len());
-        evidence.matches.insert(key, m);
+        // From image 5 on, a first-wall point to the second wall's point of the same index.
+        let offset = if k < 4 { 0 } else { 10_000 };
+        let m = matches_of(other, misplaced, |id| id + offset);
+        add_pair(&mut evidence, other, misplaced, m);
     }
     let run = check_run(
         std::slice::from_ref(&model),
@@ -388,10 +383,12 @@ fn an_image_alone_its_matches_place_where_it_is_needs_the_higher_threshold() {
     let alone = &model.images[12];
     let mut evidence = Evidence::default();
     for other in &model.images[..4] {
-        let key = (other.image.name.clone(), alone.image.name.clone());
-        let m = matches_of(other, alone, |id| id);
-        evidence.pairs.insert(key.clone(), m.len());
-        evidence.matches.insert(key, m);
+        add_pair(
+            &mut evidence,
+            other,
+            alone,
+            matches_of(other, alone, |id| id),
+        );
     }
     let check = |alone_threshold: f64| {
         let settings = CheckSettings {
