@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""The stored check reports of scripts/pipeline.sh work folders against the truth, as the
+binaries that ran the loops wrote them (no check is run again): the figures behind
+`placement_threshold` and `alone_threshold` (docs/check.md, "A placement's links kept only
+under 0.44" and "One image alone").
+
+Two tables:
+  placements  each ghost placement (`ghost_placement`) and misplaced group (`misplaced`) of
+              every report, once (the same model checked twice counts once), by score band
+              (under 0.44, from 0.44): placements, their links true and false by the exact
+              labels of `eval --labels` (full database, ground truth with the renderer's
+              scene.json).
+  alone       each ghosted model whose worst split is one image alone, once: its score,
+              whether `eval` calls that image correct, how many other images of the split are
+              wrong, and whether the report's misplaced images include it (its matches place
+              it elsewhere).
+
+usage: VGSEL=target/release/vgsel-colmap scripts/lab/stored-verdicts.py TOP [TOP ...]
+       (each TOP searched at any depth for pipeline.sh work folders)
+"""
+import collections
+import glob
+import hashlib
+import json
+import os
+import sqlite3
+import subprocess
+import sys
+import tempfile
+
+import colmap_files
+
+BAND = 0.44  # settings.rs: placement_threshold
+
+
+def reports(top):
+    """(check report, its eval report, the work folder) of every run of every work folder."""
+    for full in sorted(glob.glob(f"{top}/**/eval_full.json", recursive=True)):
+        work = os.path.dirname(full)
+        for path in sorted(glob.glob(f"{work}/check_*.json")):
+            ev = os.path.join(work, "eval_" + os.path.basename(path)[len("check_"):])
+            if os.path.exists(ev):
+                yield path, ev, work
+
+
+def ground_truth(work):
+    """The rendered scene's gt folder beside a work folder, if it has the renderer's geometry."""
+    for gt in (f"{work}/../gt", f"{work}/gt", f"{work}/../scene/gt"):
+        if os.path.exists(f"{gt}/scene.json"):
+            return gt
+    return None
+
+
+def labels(work, tmp, cache):
+    """{(name1, name2): true?} of the work folder's full database (both orders), or None."""
+    db, gt = f"{work}/full.db", ground_truth(work)
+    if gt is None or not os.path.exists(db):
+        return None
+    key = os.path.realpath(db)
+    if key not in cache:
+        csv_path = os.path.join(tmp, hashlib.md5(key.encode()).hexdigest() + ".csv")
+        subprocess.run([colmap_files.VGSEL, "eval", "--model", gt, "--ground_truth", gt,
+                        "--database_path", db, "--labels", csv_path], check=True,
+                       capture_output=True)
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True) as con:
+            names = dict(con.execute("SELECT image_id, name FROM images"))
+        by_id = colmap_files.pair_labels(csv_path)
+        cache[key] = {k: t for (a, b), t in by_id.items()
+                      for k in ((names[a], names[b]), (names[b], names[a]))}
+    return cache[key]
+
+
+def main(tops):
+    bands = collections.Counter()
+    seen_placements, seen_alone, alone = set(), set(), []
+    cache = {}
+    with tempfile.TemporaryDirectory(prefix="stored-verdicts-") as tmp:
+        for top in tops:
+            for path, ev, work in reports(top):
+                check, truth = json.load(open(path)), json.load(open(ev))
+                lab = labels(work, tmp, cache)
+                correct = {i["name"]: i["correct"] for i in truth.get("images", [])}
+                for m in check["models"]:
+                    for kind in ("ghost_placement", "misplaced"):
+                        j = m.get(kind)
+                        key = j and (kind, round(j["score"], 6), j["support"], j["correspondences"])
+                        if not j or lab is None or key in seen_placements:
+                            continue
+                        seen_placements.add(key)
+                        band = "under" if j["score"] < BAND else "from"
+                        links = [lab.get((l["image1"], l["image2"])) for l in j["links"]]
+                        bands[kind, band, "placements"] += 1
+                        bands[kind, band, "true"] += links.count(True)
+                        bands[kind, band, "false"] += links.count(False)
+                    split = m.get("worst")
+                    one = [g[0] for g in (split or {}).get("groups", []) if len(g) == 1]
+                    if not m["ghosted"] or not one or one[0] not in correct:
+                        continue
+                    placed = one[0] in {p["image"] for p in m.get("misplaced_images", [])}
+                    key = (round(m["score"], 6), one[0], placed)
+                    if key in seen_alone:
+                        continue
+                    seen_alone.add(key)
+                    others = sum(not correct.get(n, True) for g in split["groups"] for n in g
+                                 if n != one[0])
+                    alone.append((m["score"], correct[one[0]], others, placed, path))
+    print("| placements | band | placements | links true | links false |\n|---|---|---|---|---|")
+    for kind in ("ghost_placement", "misplaced"):
+        for band in ("under", "from"):
+            print(f"| {kind} | {band} {BAND} | {bands[kind, band, 'placements']} | "
+                  f"{bands[kind, band, 'true']} | {bands[kind, band, 'false']} |")
+    print("\n| image alone: score | correct | others wrong | placed elsewhere | report |")
+    print("|---|---|---|---|---|")
+    for score, ok, others, placed, path in sorted(alone):
+        print(f"| {score:.3f} | {ok} | {others} | {placed} | {path} |")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    main(sys.argv[1:])
