@@ -263,31 +263,8 @@ pub fn check_model<'e>(
     let pairs = evidence.map(|e| &e.pairs);
     let n = views.views.len();
     let covisibility = splits::Covisibility::new(&views);
-    let (mut candidates, signed) = candidates(&views, &covisibility, settings);
     let reach = conflict::Reach::new(&views, &settings.conflict);
-    let score_all = |sides: &[Vec<bool>]| -> Vec<(Vec<bool>, Counts)> {
-        (sides.par_iter())
-            .map(|side| {
-                let counts = conflict::count(&views, &reach, side, &settings.conflict);
-                (side.clone(), counts)
-            })
-            .collect()
-    };
-    let mut scored = score_all(candidates.as_slice());
-    // The worst few, each refined by its links' own conflicts, are candidates too.
-    let refined = refined_splits(&scored, &signed, &mut candidates, settings);
-    scored.extend(score_all(&refined));
-    let mut splits_scored = scored.len();
-    let mut worst = judged_split(scored, settings);
-    // An image registered alone onto the other copy (a street's camera one building off) is no
-    // split of groups; where no such split is ghosted, each image alone is scored too.
-    if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
-        let (single, scored) = worst_alone(&views, &reach, &candidates, settings);
-        splits_scored += scored;
-        if single.as_ref().is_some_and(|s| is_ghost(&s.1, settings)) {
-            worst = single;
-        }
-    }
+    let (worst, splits_scored) = scored_worst(&views, &covisibility, &reach, settings);
     let (side, split) = match worst {
         Some((side, counts)) => {
             let mut split = describe(&views, &covisibility, &side, counts, pairs);
@@ -296,9 +273,13 @@ pub fn check_model<'e>(
         }
         None => (vec![false; n], None),
     };
-    let ghosted = split
-        .as_ref()
-        .is_some_and(|s| is_ghost(&s.counts, settings));
+    let unanchored = unanchored(&views);
+    let ghosted = match &split {
+        Some(s) if is_ghost(&s.counts, settings) => {
+            !alone_placed_here(&views, s, evidence, &unanchored, settings)?
+        }
+        _ => false,
+    };
     let weakest_link = (evidence.is_some() && !ghosted)
         .then(|| weakest_link(&views, &covisibility, &reach, &side, pairs, settings))
         .flatten();
@@ -323,7 +304,7 @@ pub fn check_model<'e>(
         misplaced_images: Vec::new(),
         ghost_of_images: false,
         detached: detached(&views, &covisibility),
-        unanchored: unanchored(&views),
+        unanchored,
         neighbours_apart,
         refused: Vec::new(),
         side,
@@ -331,6 +312,43 @@ pub fn check_model<'e>(
         inner,
         views: Some(views),
     })
+}
+
+/// The split [`check_model`] judges a model by ([`judged_split`]: the candidates, the worst
+/// refined, then each image alone where no split of groups is ghosted), and how many splits
+/// were scored.
+fn scored_worst(
+    views: &Views,
+    covisibility: &splits::Covisibility,
+    reach: &conflict::Reach,
+    settings: &CheckSettings,
+) -> (Option<(Vec<bool>, Counts)>, usize) {
+    let n = views.views.len();
+    let (mut candidates, signed) = candidates(views, covisibility, settings);
+    let score_all = |sides: &[Vec<bool>]| -> Vec<(Vec<bool>, Counts)> {
+        (sides.par_iter())
+            .map(|side| {
+                let counts = conflict::count(views, reach, side, &settings.conflict);
+                (side.clone(), counts)
+            })
+            .collect()
+    };
+    let mut scored = score_all(candidates.as_slice());
+    // The worst few, each refined by its links' own conflicts, are candidates too.
+    let refined = refined_splits(&scored, &signed, &mut candidates, settings);
+    scored.extend(score_all(&refined));
+    let mut splits_scored = scored.len();
+    let mut worst = judged_split(scored, settings);
+    // An image registered alone onto the other copy (a street's camera one building off) is no
+    // split of groups; where no such split is ghosted, each image alone is scored too.
+    if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
+        let (single, scored) = worst_alone(views, reach, &candidates, settings);
+        splits_scored += scored;
+        if single.as_ref().is_some_and(|s| is_ghost(&s.1, settings)) {
+            worst = single;
+        }
+    }
+    (worst, splits_scored)
 }
 
 /// The worst split of one image alone against the rest, among those `candidates` lacks, and
@@ -726,9 +744,6 @@ pub fn check_run<'e>(
                     images.retain(|m| !c.unanchored.contains(&m.image));
                     c.misplaced_images = images;
                 }
-                if c.ghosted && alone_unplaced(c, settings) {
-                    c.ghosted = false;
-                }
                 if c.ghosted && !c.misplaced_images.is_empty() {
                     let images: Vec<&str> = c
                         .misplaced_images
@@ -758,19 +773,34 @@ pub fn check_run<'e>(
     })
 }
 
-/// A ghost of one image alone that its own matches do not place elsewhere, scoring under
-/// [`CheckSettings::alone_threshold`]: not ghosted. One image's conflicts are few beside a
-/// group's, and in correct streets an image alone scored 0.48-0.53 five times (each false
-/// alarm cost the loop a turn that blamed a right camera's pairs), where the wrong images
-/// alone scored 0.51-0.61, most of them placed elsewhere by their matches (one at 0.56 not;
-/// docs/check.md). Such a model is not searched for a misplaced group at its weakest link,
-/// as a model clean from the start is.
-fn alone_unplaced(c: &ModelCheck, settings: &CheckSettings) -> bool {
-    let Some(split) = &c.worst else { return false };
+/// Whether `split`, ghosted, is one image alone that its own matches (with the database)
+/// place where the model does, scoring under [`CheckSettings::alone_threshold`]: then the model
+/// is not ghosted. One image's conflicts are few beside a group's, and in correct streets an
+/// image alone scored 0.48-0.53 five times (each false alarm cost the loop a turn that blamed a
+/// right camera's pairs), where the wrong images alone scored 0.51-0.61, most of them placed
+/// elsewhere by their matches (one at 0.56 not; docs/check.md). An unanchored image's
+/// placement is no evidence (see [`check_run`]), so it does not place it elsewhere.
+fn alone_placed_here(
+    views: &Views,
+    split: &Split,
+    evidence: Option<&Evidence>,
+    unanchored: &[String],
+    settings: &CheckSettings,
+) -> Result<bool> {
     let Some(one) = split.groups.iter().find(|g| g.len() == 1) else {
-        return false;
+        return Ok(false);
     };
-    split.score < settings.alone_threshold && !c.misplaced_images.iter().any(|m| m.image == one[0])
+    if evidence.is_none() || split.score >= settings.alone_threshold {
+        return Ok(false);
+    }
+    if unanchored.contains(&one[0]) {
+        return Ok(true);
+    }
+    let Some(v) = views.views.iter().position(|w| w.name == one[0]) else {
+        return Ok(false);
+    };
+    let placement = resection::image_placement(views, v)?;
+    Ok(!placement.is_some_and(|p| p.misplaced()))
 }
 
 /// Each image of [`Evidence::lost_images`] that no model of `models` registered, placed in the

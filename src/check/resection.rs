@@ -165,6 +165,11 @@ pub fn image_placements(views: &Views) -> Result<Vec<ImagePlacement>> {
     Ok(placed.into_iter().flatten().collect())
 }
 
+/// [`image_placements`] of view `v` alone.
+pub fn image_placement(views: &Views, v: usize) -> Result<Option<ImagePlacement>> {
+    place(views, v, spread_of(&views.points))
+}
+
 /// The images of `views` (with a database) whose matches place them elsewhere than the model
 /// ([`ImagePlacement::misplaced`]).
 pub fn misplaced_images(views: &Views) -> Result<Vec<ImagePlacement>> {

@@ -376,7 +376,8 @@ fn no_placement_taken() -> CheckSettings {
 
 /// An image alone whose own matches place it where the model does (here only its matches to
 /// images 1-4, on the object the model has it see) is ghosted from the threshold for images
-/// alone only; from the threshold for splits where the setting is no higher.
+/// alone only; from the threshold for splits where the setting is no higher. The model's own
+/// check decides it, so a model cleared so is searched as any clean one.
 #[test]
 fn an_image_alone_its_matches_place_where_it_is_needs_the_higher_threshold() {
     let model = one_image_model(true);
@@ -412,6 +413,15 @@ fn an_image_alone_its_matches_place_where_it_is_needs_the_higher_threshold() {
         "score {}",
         lenient.score
     );
+    let model_check = |alone_threshold: f64| {
+        let settings = CheckSettings {
+            alone_threshold,
+            ..DEFAULT_SETTINGS
+        };
+        check_model(&model, Some(&evidence), &settings).unwrap()
+    };
+    assert!(model_check(DEFAULT_SETTINGS.threshold).ghosted);
+    assert!(!model_check(strict.score + 0.01).ghosted);
 }
 
 /// The one-pass count of an image alone is every sample of that split, brute force over every
