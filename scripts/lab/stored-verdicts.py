@@ -14,6 +14,10 @@ Two tables:
               whether `eval` calls that image correct, how many other images of the split are
               wrong, and whether the report's misplaced images include it (its matches place
               it elsewhere).
+  blocked     each work folder whose answer's report lists pairs that place a lost image
+              (`repair.rejoin`) that a run before it blamed (`repair.blamed`): those
+              pairs, true and false, by the run that blamed them first. The loop keeps them out
+              (docs/check.md, "Lost images placed through pairs an earlier run blamed").
 
 usage: VGSEL=target/release/vgsel-colmap scripts/lab/stored-verdicts.py TOP [TOP ...]
        (each TOP searched at any depth for pipeline.sh work folders)
@@ -70,15 +74,45 @@ def labels(work, tmp, cache):
     return cache[key]
 
 
+def run_rank(run):
+    """The loop's order of a run's name: full, pruned, repaired1, repaired2, ..."""
+    if run.startswith("repaired"):
+        return 1 + int(run[len("repaired"):])
+    return {"full": 0, "pruned": 1}.get(run, 99)
+
+
+def blocked(work, lab):
+    """{first blamer: [true, false]} of the rejoin pairs of the work folder's answer that a run
+    before it blamed, or None without an answer, labels or such pairs."""
+    answer = os.path.join(work, "answer")
+    if lab is None or not os.path.exists(answer):
+        return None
+    final = open(answer).read().strip()
+    first = {}
+    runs = [os.path.basename(p)[len("check_"):-len(".json")]
+            for p in glob.glob(f"{work}/check_*.json")]
+    for run in sorted((r for r in runs if run_rank(r) < run_rank(final)), key=run_rank):
+        for a, b in json.load(open(f"{work}/check_{run}.json"))["repair"].get("blamed", []):
+            first.setdefault((a, b), run)
+    counts = {}
+    for a, b in json.load(open(f"{work}/check_{final}.json"))["repair"].get("rejoin", []):
+        if (a, b) in first and lab.get((a, b)) is not None:
+            counts.setdefault(first[a, b], [0, 0])[0 if lab[a, b] else 1] += 1
+    return counts or None
+
+
 def main(tops):
     bands = collections.Counter()
     seen_placements, seen_alone, alone = set(), set(), []
+    blocks = {}
     cache = {}
     with tempfile.TemporaryDirectory(prefix="stored-verdicts-") as tmp:
         for top in tops:
             for path, ev, work in reports(top):
                 check, truth = json.load(open(path)), json.load(open(ev))
                 lab = labels(work, tmp, cache)
+                if work not in blocks:
+                    blocks[work] = blocked(work, lab)
                 correct = {i["name"]: i["correct"] for i in truth.get("images", [])}
                 for m in check["models"]:
                     for kind in ("ghost_placement", "misplaced"):
@@ -113,6 +147,10 @@ def main(tops):
     print("|---|---|---|---|---|")
     for score, ok, others, placed, path in sorted(alone):
         print(f"| {score:.3f} | {ok} | {others} | {placed} | {path} |")
+    print("\n| work folder | first blamed by | rejoin pairs true | false |\n|---|---|---|---|")
+    for work, counts in sorted(blocks.items()):
+        for run, (true, false) in sorted((counts or {}).items(), key=lambda c: run_rank(c[0])):
+            print(f"| {work} | {run} | {true} | {false} |")
 
 
 if __name__ == "__main__":
