@@ -96,7 +96,7 @@ pub struct ImagePlacement {
 pub struct PairMatches {
     /// The pair's image names.
     pub images: [String; 2],
-    /// The matches (sorted in [`super::ModelEvidence::dropped`]).
+    /// The matches (sorted in [`super::repair::ModelEvidence::dropped`]).
     pub matches: Vec<[u32; 2]>,
 }
 

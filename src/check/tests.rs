@@ -2,6 +2,7 @@
 //! each seeing a random 60% of what is in view) and a ghosted one (two differently textured
 //! walls whose cameras were registered onto one place, joined by a shared object).
 
+use super::repair::{blames, ModelEvidence};
 use super::*;
 use crate::colmap::model::{ModelCamera, ModelImage};
 use crate::colmap::sparse::{Point2D, SparseImage};

@@ -294,8 +294,8 @@ fn earlier_ghosts(
 ) -> Result<Vec<check::join::Glued>> {
     match evidence {
         Some(e) => {
-            let runs = check::read_runs(dirs, "--earlier_model")?;
-            Ok(check::loop_evidence(dirs, &runs, "--earlier_model", e, settings)?.1)
+            let runs = check::repair::read_runs(dirs, "--earlier_model")?;
+            Ok(check::repair::loop_evidence(dirs, &runs, "--earlier_model", e, settings)?.1)
         }
         None => Ok(Vec::new()),
     }

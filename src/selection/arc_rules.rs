@@ -2,7 +2,7 @@
 //! selects) or removed before the flow runs, besides the costs. Four sources, applied in this
 //! order: the model check's evidence (`--model`: the pairs that glued a ghosted model's copies
 //! are removed, and the pairs that link clean models placed in one frame are kept, whatever an
-//! earlier model blamed; see [`crate::check::loop_evidence`]), the user's overrides
+//! earlier model blamed; see [`crate::check::repair::loop_evidence`]), the user's overrides
 //! (`--forbid_images`, `--forbid_pairs`, which win over the models', then `--keep_pairs`),
 //! close neighbours in a capture sequence (`--keep_neighbours`), and the fitness floor
 //! (`--min_pair_fitness`, lowered as far as the search needs). The pairs the view graph does

@@ -213,14 +213,14 @@ impl Parameters {
             // The database's side of the check, read once for every --model folder, with the
             // images each run lost.
             let mut evidence = check::evidence::Evidence::load(db)?;
-            let runs = check::read_runs(&rules.model, "--model")?;
+            let runs = check::repair::read_runs(&rules.model, "--model")?;
             let lost: BTreeSet<String> = (runs.iter())
                 .flat_map(|models| evidence.lost(models, self.min_num_matches))
                 .collect();
             evidence.read_lost(db, &lost)?;
             let settings = &check::DEFAULT_SETTINGS;
             let (found, _) =
-                check::loop_evidence(&rules.model, &runs, "--model", &evidence, settings)?;
+                check::repair::loop_evidence(&rules.model, &runs, "--model", &evidence, settings)?;
             for (dir, found) in rules.model.iter().zip(found) {
                 let list = |pairs: Vec<[String; 2]>| NameList {
                     path: dir.to_path_buf(),
