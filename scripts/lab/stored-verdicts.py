@@ -15,9 +15,9 @@ Two tables:
               wrong, and whether the report's misplaced images include it (its matches place
               it elsewhere).
   blocked     each work folder whose answer's report lists pairs that place a lost image
-              (`repair.rejoin`) that a run before it blamed (`repair.blamed`): those
-              pairs, true and false, by the run that blamed them first. The loop keeps them out
-              (docs/check.md, "Lost images placed through pairs an earlier run blamed").
+              (`repair.rejoin`) that the loop blamed (its prune reports' `model_conflicts`):
+              those pairs, true and false. The loop keeps them out (docs/check.md, "Lost
+              images placed through pairs an earlier run blamed").
 
 usage: VGSEL=target/release/vgsel-colmap scripts/lab/stored-verdicts.py TOP [TOP ...]
        (each TOP searched at any depth for pipeline.sh work folders)
@@ -81,24 +81,37 @@ def run_rank(run):
     return {"full": 0, "pruned": 1}.get(run, 99)
 
 
+def loop_blamed(work, final):
+    """The pairs the loop blamed up to run `final`: the next turn's prune report lists them
+    (`overrides.model_conflicts`, every `--model` folder's: the full model's only where the
+    loop used its evidence); without that turn, the last prune's and `final`'s own."""
+    turn = run_rank(final)  # the turn after run `final` writes prune_repaired{turn}.json
+
+    def listed(k):
+        with open(f"{work}/prune_repaired{k}.json") as f:
+            return {tuple(p) for p in json.load(f)["overrides"]["model_conflicts"]}
+
+    if os.path.exists(f"{work}/prune_repaired{turn}.json"):
+        return listed(turn)
+    turns = [k for k in range(1, turn) if os.path.exists(f"{work}/prune_repaired{k}.json")]
+    with open(f"{work}/check_{final}.json") as f:
+        own = {tuple(p) for p in json.load(f)["repair"].get("blamed", [])}
+    return (listed(turns[-1]) if turns else set()) | own
+
+
 def blocked(work, lab):
-    """{first blamer: [true, false]} of the rejoin pairs of the work folder's answer that a run
-    before it blamed, or None without an answer, labels or such pairs."""
+    """[true, false] of the pairs placing a lost image in the work folder's answer that the
+    loop blamed before, or None without an answer, labels or such pairs."""
     answer = os.path.join(work, "answer")
     if lab is None or not os.path.exists(answer):
         return None
     final = open(answer).read().strip()
-    first = {}
-    runs = [os.path.basename(p)[len("check_"):-len(".json")]
-            for p in glob.glob(f"{work}/check_*.json")]
-    for run in sorted((r for r in runs if run_rank(r) < run_rank(final)), key=run_rank):
-        for a, b in json.load(open(f"{work}/check_{run}.json"))["repair"].get("blamed", []):
-            first.setdefault((a, b), run)
-    counts = {}
+    blamed = loop_blamed(work, final)
+    counts = [0, 0]
     for a, b in json.load(open(f"{work}/check_{final}.json"))["repair"].get("rejoin", []):
-        if (a, b) in first and lab.get((a, b)) is not None:
-            counts.setdefault(first[a, b], [0, 0])[0 if lab[a, b] else 1] += 1
-    return counts or None
+        if (a, b) in blamed and lab.get((a, b)) is not None:
+            counts[0 if lab[a, b] else 1] += 1
+    return counts if sum(counts) else None
 
 
 def main(tops):
@@ -147,10 +160,9 @@ def main(tops):
     print("|---|---|---|---|---|")
     for score, ok, others, placed, path in sorted(alone):
         print(f"| {score:.3f} | {ok} | {others} | {placed} | {path} |")
-    print("\n| work folder | first blamed by | rejoin pairs true | false |\n|---|---|---|---|")
-    for work, counts in sorted(blocks.items()):
-        for run, (true, false) in sorted((counts or {}).items(), key=lambda c: run_rank(c[0])):
-            print(f"| {work} | {run} | {true} | {false} |")
+    print("\n| work folder | blamed rejoin pairs true | false |\n|---|---|---|")
+    for work, counts in sorted((w, c) for w, c in blocks.items() if c):
+        print(f"| {work} | {counts[0]} | {counts[1]} |")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """stored-verdicts.py's third table on reports written here: the pairs that place a lost image in
-a loop's answer that an earlier run blamed, true and false by the run that blamed them first
-(the runs in the loop's order, not the files')."""
+a loop's answer that the loop blamed, from the prune report of the turn after the answer (every
+`--model` folder's blame, whatever the check reports beside it say), else from the last prune's
+and the answer's own."""
 import importlib.util
 import json
 import os
@@ -14,28 +15,41 @@ spec = importlib.util.spec_from_file_location("stored_verdicts",
 stored_verdicts = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(stored_verdicts)
 
+LAB_TRUTH = {("a", "b"): True, ("a", "c"): False, ("b", "d"): True, ("c", "d"): False,
+             ("d", "e"): True}
+REJOIN = [["a", "b"], ["a", "c"], ["b", "d"], ["c", "d"], ["d", "e"]]
+
+
+def write(d, name, value):
+    with open(os.path.join(d, name), "w") as f:
+        json.dump(value, f) if not isinstance(value, str) else f.write(value)
+
+
+def prune(blamed):
+    return {"overrides": {"model_conflicts": blamed}}
+
 
 class Blocked(unittest.TestCase):
-    def test_rejoin_pairs_by_first_blamer(self):
-        reports = {
-            "full": {"blamed": [["a", "c"]]},
-            "repaired2": {"blamed": [["a", "b"], ["b", "d"]]},
-            "repaired9": {"blamed": [["a", "b"], ["a", "c"]]},
-            "repaired10": {"rejoin": [["a", "b"], ["a", "c"], ["b", "d"], ["c", "d"], ["d", "e"]]},
-            "repaired11": {"blamed": [["c", "d"]]},  # after the answer: not counted
-        }
-        lab = {("a", "b"): True, ("a", "c"): False, ("b", "d"): True, ("c", "d"): False,
-               ("d", "e"): True}
+    def test_the_next_turns_prune_lists_what_the_loop_blamed(self):
         with tempfile.TemporaryDirectory() as d:
-            for run, repair in reports.items():
-                with open(os.path.join(d, f"check_{run}.json"), "w") as f:
-                    json.dump({"repair": repair}, f)
-            self.assertIsNone(stored_verdicts.blocked(d, lab))  # no answer yet
-            with open(os.path.join(d, "answer"), "w") as f:
-                f.write("repaired10\n")
-            self.assertEqual(stored_verdicts.blocked(d, lab),
-                             {"full": [0, 1], "repaired2": [2, 0]})
+            # The full model's check blamed (a, c), but the loop did not use its evidence.
+            write(d, "check_full.json", {"repair": {"blamed": [["a", "c"]]}})
+            write(d, "check_repaired1.json", {"repair": {"rejoin": REJOIN}})
+            write(d, "prune_repaired1.json", prune([["a", "b"]]))
+            write(d, "prune_repaired2.json", prune([["a", "b"], ["c", "d"]]))
+            self.assertIsNone(stored_verdicts.blocked(d, LAB_TRUTH))  # no answer yet
+            write(d, "answer", "repaired1\n")
+            self.assertEqual(stored_verdicts.blocked(d, LAB_TRUTH), [1, 1])
             self.assertIsNone(stored_verdicts.blocked(d, None))
+
+    def test_without_a_next_turn_the_last_prune_and_the_answers_own_blame(self):
+        with tempfile.TemporaryDirectory() as d:
+            write(d, "check_repaired3.json",
+                  {"repair": {"rejoin": REJOIN, "blamed": [["d", "e"]]}})
+            write(d, "prune_repaired1.json", prune([["a", "b"]]))
+            write(d, "prune_repaired3.json", prune([["a", "b"], ["b", "d"]]))
+            write(d, "answer", "repaired3\n")
+            self.assertEqual(stored_verdicts.blocked(d, LAB_TRUTH), [3, 0])
 
 
 if __name__ == "__main__":
