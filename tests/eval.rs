@@ -88,5 +88,26 @@ fn sub_models_are_scored_separately_and_missing_images_are_not_registered() {
     );
     let s = score(&dir.path().join("sparse"), &dir.path().join("gt")).unwrap();
     assert_eq!((s.models, s.registered, s.correct), (2, 9, 9));
+    assert_eq!(s.wrong_registrations, 0);
     assert!(s.images.iter().any(|i| i.model == 1));
+}
+
+/// An image registered in two sub-models, right in one and wrong in the other (a mapper's
+/// small second copy beside a ghost), is correct with its best score, and its wrong
+/// registration is counted apart.
+#[test]
+fn an_image_wrong_in_one_sub_model_and_right_in_another_is_a_wrong_registration() {
+    let dir = tempfile::tempdir().unwrap();
+    let gt = truth(dir.path());
+    write(&gt, &dir.path().join("gt"));
+    let mut ghost = transformed(&gt, |_| true);
+    let other = ghost.images[6].clone();
+    ghost.images[0].centre = other.centre;
+    ghost.images[0].rotation = other.rotation;
+    ghost.images[0].translation = other.translation;
+    write(&ghost, &dir.path().join("sparse/0"));
+    write(&transformed(&gt, |k| k < 4), &dir.path().join("sparse/1"));
+    let s = score(&dir.path().join("sparse"), &dir.path().join("gt")).unwrap();
+    assert_eq!((s.models, s.registered, s.correct), (2, 12, 12));
+    assert_eq!(s.wrong_registrations, 1);
 }

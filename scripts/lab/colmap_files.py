@@ -66,6 +66,13 @@ def only_pairs(db, out, keep, work, tag):
                    check=True, capture_output=True)
 
 
+def every_camera_right(e):
+    """An `eval` report's truth for a run: every camera it registered right, in every sub-model
+    that registers it (`wrong_registrations`: an image right in one sub-model and wrong in
+    another, a mapper's small second copy beside a ghost; reports before session 41 lack it)."""
+    return e.get("correct") == e["registered"] and not e.get("wrong_registrations", 0)
+
+
 def pair_labels(path):
     """{(image_id1, image_id2): true?} of a `vgsel-colmap eval --labels` CSV."""
     with open(path) as f:

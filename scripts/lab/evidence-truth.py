@@ -46,7 +46,7 @@ def placements(work, tmp):
                               "--database_path", db, "--placements", path],
                              capture_output=True, text=True, check=True)
         e = json.loads(out.stdout)
-        whole = e["correct"] == e["registered"]
+        whole = colmap_files.every_camera_right(e)
         for row in csv.DictReader(open(path)):
             row["model_truth"] = "correct" if whole else "wrong"
             row["folder"] = model

@@ -3,7 +3,7 @@
 below the folders given: one row per loop (the full run, then each run the loop mapped, with
 its right cameras, registered cameras, models and `check` verdict, and the loop's answer), then
 the check's verdicts over every run it checked, against the truth that every registered camera
-is right (docs/check.md, "At pipeline.sh's defaults").
+is right, in every sub-model that registers it (docs/check.md, "At pipeline.sh's defaults").
 
 usage: scripts/lab/loop-counts.py DIR...
 """
@@ -11,6 +11,8 @@ import glob
 import json
 import os
 import sys
+
+import colmap_files
 
 
 def cell(e):
@@ -46,7 +48,7 @@ def main(dirs):
         for e in done.values():
             if e["check"] == "-" or e["registered"] == 0:
                 continue
-            truth = "correct" if e.get("correct") == e["registered"] else "wrong"
+            truth = "correct" if colmap_files.every_camera_right(e) else "wrong"
             flagged[truth][0] += e["check"] != "clean"
             flagged[truth][1] += 1
     print(f"correct models flagged: {flagged['correct'][0]} of {flagged['correct'][1]}; "

@@ -44,13 +44,13 @@ def models(args):
     for work in args.loops:
         for model, db, _, _, ev in colmap_files.loop_runs(work):
             e = json.load(open(ev))
-            truth = "correct" if e["correct"] == e["registered"] else "wrong"
+            truth = "correct" if colmap_files.every_camera_right(e) else "wrong"
             yield "loops", truth, model, db
     for top in args.pipelines:
         for model, db, ev in colmap_files.pipeline_runs(top):
             e = json.load(open(ev))
             if "images" in e:
-                truth = "correct" if e["correct"] == e["registered"] else "wrong"
+                truth = "correct" if colmap_files.every_camera_right(e) else "wrong"
                 yield "pipelines", truth, model, db
     for work in args.scenes:
         for scene in sorted(glob.glob(f"{work}/*/full.db")):
@@ -63,7 +63,7 @@ def models(args):
                     ev = sub + ".eval.json"
                     e = json.load(open(ev)) if os.path.exists(ev) else {}
                     truth = ("unknown" if "images" not in e else
-                             "correct" if e["correct"] == e["registered"] else "wrong")
+                             "correct" if colmap_files.every_camera_right(e) else "wrong")
                     yield "scenes", truth, sub, os.path.join(d, db)
     if args.peers:
         spec = importlib.util.spec_from_file_location(

@@ -36,8 +36,13 @@ pub struct Scores {
     pub images_ground_truth: usize,
     /// Ground-truth images the reconstruction registered.
     pub registered: usize,
-    /// Of those, the ones within tolerance ([`ImageScore::correct`]).
+    /// Of those, the ones within tolerance ([`ImageScore::correct`]) in some sub-model.
     pub correct: usize,
+    /// Registrations outside the tolerances, an image counted once per sub-model that places
+    /// it wrong: an image a mapper registered twice, right in one sub-model and wrong in the
+    /// other (a small second copy beside a ghost), is `correct` but counted here, so "every
+    /// camera right" is `correct == registered` and none here.
+    pub wrong_registrations: usize,
     /// Medians over registered images (relative position error, degrees); null when none.
     pub median_position_error: Option<f64>,
     /// Median rotation error over registered images (degrees); null when none.
@@ -51,7 +56,8 @@ pub struct Scores {
 
 /// Scores every model under `sparse` (one model folder or a folder of sub-models) against the
 /// ground-truth model in `ground_truth`. An image registered in several sub-models counts once,
-/// with its best score.
+/// with its best score; each of its wrong registrations counts in
+/// [`Scores::wrong_registrations`].
 pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
     let truth = sparse::read_images(ground_truth)?;
     ensure!(
@@ -61,7 +67,7 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
     );
     let dirs = model::model_dirs(sparse)?;
     let mut best: HashMap<String, ImageScore> = HashMap::new();
-    let mut observations = 0;
+    let (mut observations, mut wrong_registrations) = (0, 0);
     for (index, dir) in dirs.iter().enumerate() {
         let estimated = sparse::read_images(dir)?;
         observations += estimated.iter().map(|im| im.observations).sum::<usize>();
@@ -78,6 +84,7 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
                     && rotation < ROTATION_TOLERANCE_DEG,
                 name: name.clone(),
             };
+            wrong_registrations += usize::from(!score.correct);
             let better = |old: &ImageScore| {
                 (score.correct, -score.position_error) > (old.correct, -old.position_error)
             };
@@ -97,6 +104,7 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
         images_ground_truth: truth.len(),
         registered: images.len(),
         correct: images.iter().filter(|s| s.correct).count(),
+        wrong_registrations,
         median_position_error: median(images.iter().map(|s| s.position_error).collect()),
         median_rotation_error_deg: median(images.iter().map(|s| s.rotation_error_deg).collect()),
         observations,

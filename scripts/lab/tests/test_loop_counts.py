@@ -21,8 +21,13 @@ class LoopCounts(unittest.TestCase):
         no_loop = {"full": e(20, 20, "-"), "pruned": e(20, 20, "-")}
         false_alarm = {"full": e(0, 0, "-"), "pruned": e(30, 30, "misplaced", models=3),
                        "repaired1": e(12, 20, "clean"), "loop_answer": "repaired1"}
+        # Every camera right by its best registration, but one wrong in a second sub-model.
+        second_copy = {"full": e(40, 40, "clean"),
+                       "pruned": dict(e(40, 40, "ghosted", models=2), wrong_registrations=13),
+                       "loop_answer": "pruned"}
         with tempfile.TemporaryDirectory() as d:
-            for name, summary in [("a/global", loop), ("b", no_loop), ("c/x/y", false_alarm)]:
+            for name, summary in [("a/global", loop), ("b", no_loop), ("c/x/y", false_alarm),
+                                  ("d", second_copy)]:
                 os.makedirs(os.path.join(d, name))
                 with open(os.path.join(d, name, "summary.json"), "w") as f:
                     json.dump(summary, f)
@@ -31,8 +36,8 @@ class LoopCounts(unittest.TestCase):
                                  "| repaired1: 38/38 clean |")
         self.assertEqual(out[3], f"| {d}/c/x/y | 0/0 - | 30/30 (3 models) misplaced → 12/20 clean "
                                  "| repaired1: 12/20 clean |")
-        self.assertEqual(len(out), 5)  # the loop-less folder has no row
-        self.assertEqual(out[4], "correct models flagged: 1 of 2; wrong models flagged: 2 of 3")
+        self.assertEqual(len(out), 6)  # the loop-less folder has no row
+        self.assertEqual(out[5], "correct models flagged: 1 of 3; wrong models flagged: 3 of 4")
 
 
 if __name__ == "__main__":
