@@ -40,6 +40,16 @@ fn transformed(gt: &GroundTruth, keep: impl Fn(usize) -> bool) -> GroundTruth {
     out
 }
 
+/// The whole transformed copy with camera 0 moved onto camera 6's pose: one camera wrong.
+fn camera_0_on_6(gt: &GroundTruth) -> GroundTruth {
+    let mut ghost = transformed(gt, |_| true);
+    let other = ghost.images[6].clone();
+    ghost.images[0].centre = other.centre;
+    ghost.images[0].rotation = other.rotation;
+    ghost.images[0].translation = other.translation;
+    ghost
+}
+
 fn write(gt: &GroundTruth, dir: &Path) {
     std::fs::create_dir_all(dir).unwrap();
     write_gt_model(gt, dir).unwrap();
@@ -59,12 +69,7 @@ fn a_similar_model_is_all_correct_and_a_moved_camera_is_not() {
     assert!(s.median_position_error.unwrap() < 1e-9);
 
     // Move one camera to another camera's place: registered, not correct.
-    let mut ghost = transformed(&gt, |_| true);
-    let other = ghost.images[6].clone();
-    ghost.images[0].centre = other.centre;
-    ghost.images[0].rotation = other.rotation;
-    ghost.images[0].translation = other.translation;
-    write(&ghost, &dir.path().join("ghost"));
+    write(&camera_0_on_6(&gt), &dir.path().join("ghost"));
     let s = score(&dir.path().join("ghost"), &dir.path().join("gt")).unwrap();
     assert_eq!((s.registered, s.correct), (12, 11));
     let wrong: Vec<&str> = s
@@ -100,12 +105,7 @@ fn an_image_wrong_in_one_sub_model_and_right_in_another_is_a_wrong_registration(
     let dir = tempfile::tempdir().unwrap();
     let gt = truth(dir.path());
     write(&gt, &dir.path().join("gt"));
-    let mut ghost = transformed(&gt, |_| true);
-    let other = ghost.images[6].clone();
-    ghost.images[0].centre = other.centre;
-    ghost.images[0].rotation = other.rotation;
-    ghost.images[0].translation = other.translation;
-    write(&ghost, &dir.path().join("sparse/0"));
+    write(&camera_0_on_6(&gt), &dir.path().join("sparse/0"));
     write(&transformed(&gt, |k| k < 4), &dir.path().join("sparse/1"));
     let s = score(&dir.path().join("sparse"), &dir.path().join("gt")).unwrap();
     assert_eq!((s.models, s.registered, s.correct), (2, 12, 12));
