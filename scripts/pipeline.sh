@@ -287,13 +287,24 @@ fmt = lambda x, f: "-" if x is None else f % x
 
 print(f"{'database':<10} {'pairs':>6} {'mapper s':>9} {'models':>6} {'registered':>10} "
       f"{'correct':>7} {'med. pos':>9} {'med. rot':>9} {'false pairs':>11} {'check':>10}")
+# An image registered in several models is `correct` by its best registration: a run with more
+# wrong registrations than wrong cameras has one wrong in another of its models (a ghost beside a
+# small copy), and is marked.
+elsewhere = {}
 for v, e in rows.items():
     p = e.get("pairs") or {}
+    correct = fmt(e.get("correct"), "%d")
+    wrong = e.get("wrong_registrations", 0)
+    if "correct" in e and wrong > e["registered"] - e["correct"]:
+        elsewhere[v], correct = wrong, correct + "*"
     print(f"{v:<10} {e['pairs_used']:>6} {e['mapper_seconds']:>9.1f} {e['models']:>6} "
           f"{str(e['registered']) + '/' + str(e['images_total']):>10} "
-          f"{fmt(e.get('correct'), '%d'):>7} {fmt(e.get('median_position_error'), '%.4f'):>9} "
+          f"{correct:>7} {fmt(e.get('median_position_error'), '%.4f'):>9} "
           f"{fmt(e.get('median_rotation_error_deg'), '%.2f°'):>9} {fmt(p.get('false'), '%d'):>11} "
           f"{e['check']:>10}")
+for v, n in elsewhere.items():
+    print(f"* {v}: an image registered in more than one model is wrong in one of them "
+          f"({n} wrong registrations)")
 summary = {"extract_seconds": t_extract, "match_seconds": t_match,
            "prune": json.load(open(f"{work}/prune.json")), **rows}
 if os.path.exists(f"{work}/answer"):
