@@ -81,10 +81,11 @@ def run_rank(run):
     return {"full": 0, "pruned": 1}.get(run, 99)
 
 
-def loop_blamed(work, final):
-    """The pairs the loop blamed up to run `final`: the next turn's prune report lists them
-    (`overrides.model_conflicts`, every `--model` folder's: the full model's only where the
-    loop used its evidence); without that turn, the last prune's and `final`'s own."""
+def loop_blamed(work, final, report):
+    """The pairs the loop blamed up to run `final` (`report`: its check report): the next turn's
+    prune report lists them (`overrides.model_conflicts`, every `--model` folder's: the full
+    model's only where the loop used its evidence); without that turn, the last prune's and
+    `final`'s own."""
     turn = run_rank(final)  # the turn after run `final` writes prune_repaired{turn}.json
 
     def listed(k):
@@ -94,8 +95,7 @@ def loop_blamed(work, final):
     if os.path.exists(f"{work}/prune_repaired{turn}.json"):
         return listed(turn)
     turns = [k for k in range(1, turn) if os.path.exists(f"{work}/prune_repaired{k}.json")]
-    with open(f"{work}/check_{final}.json") as f:
-        own = {tuple(p) for p in json.load(f)["repair"].get("blamed", [])}
+    own = {tuple(p) for p in report["repair"].get("blamed", [])}
     return (listed(turns[-1]) if turns else set()) | own
 
 
@@ -106,9 +106,11 @@ def blocked(work, lab):
     if lab is None or not os.path.exists(answer):
         return None
     final = open(answer).read().strip()
-    blamed = loop_blamed(work, final)
+    with open(f"{work}/check_{final}.json") as f:
+        report = json.load(f)
+    blamed = loop_blamed(work, final, report)
     counts = [0, 0]
-    for a, b in json.load(open(f"{work}/check_{final}.json"))["repair"].get("rejoin", []):
+    for a, b in report["repair"].get("rejoin", []):
         if (a, b) in blamed and lab.get((a, b)) is not None:
             counts[0 if lab[a, b] else 1] += 1
     return counts if sum(counts) else None

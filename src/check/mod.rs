@@ -716,11 +716,7 @@ pub fn check_run<'e>(
                 // be one image off, not two groups.
                 if let (false, Some(views)) = (c.ghosted && c.ghost_placement.is_some(), &c.views) {
                     let mut images = resection::misplaced_images(views)?;
-                    // An unanchored image's pose rests on nothing its matches could correct:
-                    // their pose is a registration afresh, which false matches to the other
-                    // copy can carry (a hall orbit registered without points: 13 such images,
-                    // their links false). The image is told as unanchored.
-                    images.retain(|m| !c.unanchored.contains(&m.image));
+                    images.retain(|m| placed_elsewhere(m, &c.unanchored));
                     c.misplaced_images = images;
                 }
                 if c.ghosted && !c.misplaced_images.is_empty() {
@@ -757,8 +753,7 @@ pub fn check_run<'e>(
 /// is not ghosted. One image's conflicts are few beside a group's, and in correct streets an
 /// image alone scored 0.48-0.53 five times (each false alarm cost the loop a turn that blamed a
 /// right camera's pairs), where the wrong images alone scored 0.51-0.61, most of them placed
-/// elsewhere by their matches (one at 0.56 not; docs/check.md). An unanchored image's
-/// placement is no evidence (see [`check_run`]), so it does not place it elsewhere.
+/// elsewhere by their matches (one at 0.56 not; docs/check.md).
 fn alone_placed_here(
     views: &Views,
     split: &Split,
@@ -772,14 +767,20 @@ fn alone_placed_here(
     if evidence.is_none() || split.score >= settings.alone_threshold {
         return Ok(false);
     }
-    if unanchored.contains(&one[0]) {
-        return Ok(true);
-    }
     let Some(v) = views.views.iter().position(|w| w.name == one[0]) else {
         return Ok(false);
     };
     let placement = resection::image_placement(views, v)?;
-    Ok(!placement.is_some_and(|p| p.misplaced()))
+    Ok(!placement.is_some_and(|p| placed_elsewhere(&p, unanchored)))
+}
+
+/// Whether `placement` is evidence that the model put its image where its matches do not
+/// ([`resection::ImagePlacement::misplaced`]). An unanchored image's pose rests on nothing its
+/// matches could correct: their pose is a registration afresh, which false matches to the
+/// other copy can carry (a hall orbit registered without points: 13 such images, their links
+/// false). Such an image is told as unanchored, not as placed elsewhere.
+fn placed_elsewhere(placement: &resection::ImagePlacement, unanchored: &[String]) -> bool {
+    placement.misplaced() && !unanchored.contains(&placement.image)
 }
 
 /// Each image of [`Evidence::lost_images`] that no model of `models` registered, placed in the
