@@ -10,10 +10,14 @@ Two tables:
               (under 0.44, from 0.44): placements, their links true and false by the exact
               labels of `eval --labels` (full database, ground truth with the renderer's
               scene.json).
-  alone       each ghosted model whose worst split is one image alone, once: its score,
-              whether `eval` calls that image correct, how many other images of the split are
+  alone       each model whose worst split is one image alone at the threshold or above
+              (ghosted, or cleared by the image-alone rule since session 40), once: its score,
+              whether `eval` calls that image correct, how many other images of the model are
               wrong, and whether the report's misplaced images include it (its matches place
-              it elsewhere).
+              it elsewhere). The truth is the model's own (`eval` on that sub-model) where the
+              ground truth lies beside the work folder: a run's eval keeps each image's best
+              registration, and a model's wrong cameras hide behind another model's right ones.
+              Elsewhere it is the run's eval (the truth column says which).
   blocked     each work folder whose answer's report lists pairs that place a lost image
               (`repair.rejoin`) that the loop blamed (its prune reports' `model_conflicts`):
               those pairs, true and false. The loop keeps them out (docs/check.md, "Lost
@@ -38,7 +42,8 @@ BAND = 0.44  # settings.rs: placement_threshold
 
 
 def reports(top):
-    """(check report, its eval report, the work folder) of every run of every work folder."""
+    """(check report, the run's eval report, the work folder) of every run of every work
+    folder that `eval` scored (a run with a ground truth)."""
     for full in sorted(glob.glob(f"{top}/**/eval_full.json", recursive=True)):
         work = os.path.dirname(full)
         for path in sorted(glob.glob(f"{work}/check_*.json")):
@@ -47,12 +52,43 @@ def reports(top):
                 yield path, ev, work
 
 
-def ground_truth(work):
-    """The rendered scene's gt folder beside a work folder, if it has the renderer's geometry."""
+def ground_truth(work, exact=True):
+    """The rendered scene's gt folder beside a work folder: with the renderer's geometry
+    (`scene.json`, what exact labels need) if `exact`, else any with the cameras."""
     for gt in (f"{work}/../gt", f"{work}/gt", f"{work}/../scene/gt"):
-        if os.path.exists(f"{gt}/scene.json"):
+        if os.path.exists(f"{gt}/scene.json" if exact else f"{gt}/images.txt"):
             return gt
     return None
+
+
+def model_truth(work, model, cache):
+    """{image name: correct?} of one sub-model of a check report (its `model` path) on its own,
+    or None without a ground truth or the model."""
+    gt = ground_truth(work, exact=False)
+    if not os.path.isdir(model):  # a work folder moved since: the run's folder and sub-model
+        model = os.path.join(work, *model.rstrip("/").split("/")[-2:])
+    if gt is None or not os.path.isdir(model):
+        return None
+    key = os.path.realpath(model)
+    if key not in cache:
+        out = subprocess.run([colmap_files.VGSEL, "eval", "-q", "--model", model,
+                              "--ground_truth", gt], check=True, capture_output=True, text=True)
+        cache[key] = {i["name"]: i["correct"] for i in json.loads(out.stdout)["images"]
+                      if i.get("model") is not None}
+    return cache[key]
+
+
+def alone_row(m, threshold, truth):
+    """(score, image right?, other images of the model wrong, placed elsewhere?) of a model
+    whose worst split is one image alone scoring `threshold` or more, by the model's own
+    truth; else None."""
+    split = m.get("worst")
+    one = [g[0] for g in (split or {}).get("groups", []) if len(g) == 1]
+    if m["score"] < threshold or not one or truth is None or one[0] not in truth:
+        return None
+    placed = one[0] in {p["image"] for p in m.get("misplaced_images", [])}
+    others = sum(not ok for n, ok in truth.items() if n != one[0])
+    return m["score"], truth[one[0]], others, placed
 
 
 def labels(work, tmp, cache):
@@ -120,15 +156,14 @@ def main(tops):
     bands = collections.Counter()
     seen_placements, seen_alone, alone = set(), set(), []
     blocks = {}
-    cache = {}
+    cache, truths = {}, {}
     with tempfile.TemporaryDirectory(prefix="stored-verdicts-") as tmp:
         for top in tops:
             for path, ev, work in reports(top):
-                check, truth = json.load(open(path)), json.load(open(ev))
+                check = json.load(open(path))
                 lab = labels(work, tmp, cache)
                 if work not in blocks:
                     blocks[work] = blocked(work, lab)
-                correct = {i["name"]: i["correct"] for i in truth.get("images", [])}
                 for m in check["models"]:
                     for kind in ("ghost_placement", "misplaced"):
                         j = m.get(kind)
@@ -141,27 +176,29 @@ def main(tops):
                         bands[kind, band, "placements"] += 1
                         bands[kind, band, "true"] += links.count(True)
                         bands[kind, band, "false"] += links.count(False)
-                    split = m.get("worst")
-                    one = [g[0] for g in (split or {}).get("groups", []) if len(g) == 1]
-                    if not m["ghosted"] or not one or one[0] not in correct:
+                    threshold = check["settings"]["threshold"]
+                    if m["score"] < threshold:
                         continue
-                    placed = one[0] in {p["image"] for p in m.get("misplaced_images", [])}
-                    key = (round(m["score"], 6), one[0], placed)
-                    if key in seen_alone:
+                    truth, source = model_truth(work, m["model"], truths), "model"
+                    if truth is None:
+                        best = {i["name"]: i["correct"] for i in json.load(open(ev))["images"]}
+                        names = [n for g in (m.get("worst") or {}).get("groups", []) for n in g]
+                        truth, source = {n: best[n] for n in names if n in best}, "run"
+                    row = alone_row(m, threshold, truth)
+                    key = row and (round(row[0], 6), row[1], row[3])
+                    if row is None or key in seen_alone:
                         continue
                     seen_alone.add(key)
-                    others = sum(not correct.get(n, True) for g in split["groups"] for n in g
-                                 if n != one[0])
-                    alone.append((m["score"], correct[one[0]], others, placed, path))
+                    alone.append((*row, source, m["model"]))
     print("| placements | band | placements | links true | links false |\n|---|---|---|---|---|")
     for kind in ("ghost_placement", "misplaced"):
         for band in ("under", "from"):
             print(f"| {kind} | {band} {BAND} | {bands[kind, band, 'placements']} | "
                   f"{bands[kind, band, 'true']} | {bands[kind, band, 'false']} |")
-    print("\n| image alone: score | correct | others wrong | placed elsewhere | report |")
-    print("|---|---|---|---|---|")
-    for score, ok, others, placed, path in sorted(alone):
-        print(f"| {score:.3f} | {ok} | {others} | {placed} | {path} |")
+    print("\n| image alone: score | correct | others wrong | placed elsewhere | truth | model |")
+    print("|---|---|---|---|---|---|")
+    for score, ok, others, placed, source, path in sorted(alone):
+        print(f"| {score:.3f} | {ok} | {others} | {placed} | {source} | {path} |")
     print("\n| work folder | blamed rejoin pairs true | false |\n|---|---|---|")
     for work, counts in sorted((w, c) for w, c in blocks.items() if c):
         print(f"| {work} | {counts[0]} | {counts[1]} |")

@@ -1,14 +1,17 @@
-"""stored-verdicts.py's third table on reports written here: the pairs that place a lost image in
-a loop's answer that the loop blamed, from the prune report of the turn after the answer (every
-`--model` folder's blame, whatever the check reports beside it say), else from the last prune's
-and the answer's own."""
+"""stored-verdicts.py on reports written here. Its second table: an image alone judged by the
+model's own truth. Its third: the pairs that place a lost image in a loop's answer that the loop
+blamed, from the prune report of the turn after the answer (every `--model` folder's blame,
+whatever the check reports beside it say), else from the last prune's and the answer's own."""
 import importlib.util
 import json
 import os
+import sys
 import tempfile
 import unittest
 
 from lab_tool import LAB
+
+sys.path.insert(0, LAB)  # the script imports colmap_files from its own folder
 
 spec = importlib.util.spec_from_file_location("stored_verdicts",
                                               os.path.join(LAB, "stored-verdicts.py"))
@@ -27,6 +30,29 @@ def write(d, name, value):
 
 def prune(blamed):
     return {"overrides": {"model_conflicts": blamed}}
+
+
+def alone_model(score, image="0005.png"):
+    return {"score": score, "worst": {"groups": [["0000.png", "0001.png", "0002.png"], [image]]},
+            "misplaced_images": [{"image": "0001.png"}]}
+
+
+class Alone(unittest.TestCase):
+    def test_the_models_own_wrong_cameras_count(self):
+        # Right in the run's best registration, 0000 and 0001 are wrong in this model: the
+        # street of 20 images' preset run (session 39), cleared at 0.48 by the image-alone rule.
+        truth = {"0000.png": False, "0001.png": False, "0002.png": True, "0005.png": True}
+        self.assertEqual(stored_verdicts.alone_row(alone_model(0.48), 0.48, truth),
+                         (0.48, True, 2, False))
+        placed = alone_model(0.5, "0001.png")
+        self.assertEqual(stored_verdicts.alone_row(placed, 0.48, truth), (0.5, False, 1, True))
+
+    def test_under_the_threshold_or_without_truth_no_row(self):
+        truth = {"0005.png": True}
+        self.assertIsNone(stored_verdicts.alone_row(alone_model(0.47), 0.48, truth))
+        self.assertIsNone(stored_verdicts.alone_row(alone_model(0.5), 0.48, None))
+        groups = {"score": 0.6, "worst": {"groups": [["0000.png"] * 3, ["0005.png"] * 3]}}
+        self.assertIsNone(stored_verdicts.alone_row(groups, 0.48, truth))
 
 
 class Blocked(unittest.TestCase):
