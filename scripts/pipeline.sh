@@ -3,7 +3,8 @@
 # database by vgsel-colmap, the mapper on the full and on the pruned database, and (given a
 # ground-truth model) `vgsel-colmap eval` of both. Prints one side-by-side table (with REPAIR,
 # each run's `check` verdict too) and writes WORKDIR/summary.json (each run's eval under its
-# name, full, pruned, repairedK, in that order, with its `check` verdict; the loop's answer). COLMAP 3.8 (`colmap`) by default; COLMAP 4.2 through pycolmap (MATCHER,
+# name, full, pruned, repairedK, in that order, with its `check` verdict; the loop's answer; the
+# ground truth's folder). COLMAP 3.8 (`colmap`) by default; COLMAP 4.2 through pycolmap (MATCHER,
 # MAPPER), in the venv scripts/ci/pycolmap-venv.sh makes.
 #
 # usage: scripts/pipeline.sh IMAGES WORKDIR [GT]
@@ -258,9 +259,9 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
   echo "$answer" >"$work/answer"
 fi
 
-python3 - "$work" "$t_extract" "$t_match" <<'EOF'
+python3 - "$work" "$t_extract" "$t_match" "$gt" <<'EOF'
 import json, os, sys
-work, t_extract, t_match = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+work, t_extract, t_match, gt = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
 
 
 def verdict(variant):
@@ -305,7 +306,7 @@ for v, e in rows.items():
 for v, n in elsewhere.items():
     print(f"* {v}: an image registered in more than one model is wrong in one of them "
           f"({n} wrong registrations)")
-summary = {"extract_seconds": t_extract, "match_seconds": t_match,
+summary = {"extract_seconds": t_extract, "match_seconds": t_match, "ground_truth": gt or None,
            "prune": json.load(open(f"{work}/prune.json")), **rows}
 if os.path.exists(f"{work}/answer"):
     summary["loop_answer"] = open(f"{work}/answer").read().strip()

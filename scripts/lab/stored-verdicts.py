@@ -15,7 +15,7 @@ Two tables:
               whether `eval` calls that image correct, how many other images of the model are
               wrong, and whether the report's misplaced images include it (its matches place
               it elsewhere). The truth is the model's own (`eval` on that sub-model) where the
-              ground truth lies beside the work folder: a run's eval keeps each image's best
+              ground truth is found (summary.json's, or a gt folder beside the work folder): a run's eval keeps each image's best
               registration, and a model's wrong cameras hide behind another model's right ones.
               Elsewhere it is the run's eval (the truth column says which).
   blocked     each work folder whose answer's report lists pairs that place a lost image
@@ -53,9 +53,15 @@ def reports(top):
 
 
 def ground_truth(work, exact=True):
-    """The rendered scene's gt folder beside a work folder: with the renderer's geometry
-    (`scene.json`, what exact labels need) if `exact`, else any with the cameras."""
-    for gt in (f"{work}/../gt", f"{work}/gt", f"{work}/../scene/gt"):
+    """The work folder's ground truth (as pipeline.sh recorded it, else a gt folder beside it):
+    with the renderer's geometry (`scene.json`, what exact labels need) if `exact`, else any
+    with the cameras."""
+    candidates = [f"{work}/../gt", f"{work}/gt", f"{work}/../scene/gt"]
+    if os.path.exists(f"{work}/summary.json"):
+        recorded = json.load(open(f"{work}/summary.json")).get("ground_truth")
+        if recorded:
+            candidates.insert(0, recorded)
+    for gt in candidates:
         if os.path.exists(f"{gt}/scene.json" if exact else f"{gt}/images.txt"):
             return gt
     return None

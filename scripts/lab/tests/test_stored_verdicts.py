@@ -55,6 +55,21 @@ class Alone(unittest.TestCase):
         self.assertIsNone(stored_verdicts.alone_row(groups, 0.48, truth))
 
 
+class GroundTruth(unittest.TestCase):
+    def test_the_one_pipeline_recorded_else_a_gt_folder_beside(self):
+        with tempfile.TemporaryDirectory() as d:
+            work, recorded, beside = (os.path.join(d, x) for x in ("work", "elsewhere", "gt"))
+            for folder in (work, recorded, beside):
+                os.makedirs(folder)
+                write(folder, "images.txt", "")
+            self.assertEqual(stored_verdicts.ground_truth(work, exact=False), f"{work}/../gt")
+            self.assertIsNone(stored_verdicts.ground_truth(work))  # no scene.json: not exact
+            write(work, "summary.json", {"ground_truth": recorded})
+            self.assertEqual(stored_verdicts.ground_truth(work, exact=False), recorded)
+            write(work, "summary.json", {"ground_truth": None})
+            self.assertEqual(stored_verdicts.ground_truth(work, exact=False), f"{work}/../gt")
+
+
 class Blocked(unittest.TestCase):
     def test_the_next_turns_prune_lists_what_the_loop_blamed(self):
         with tempfile.TemporaryDirectory() as d:
