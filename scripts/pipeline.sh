@@ -253,7 +253,10 @@ done
 # pieces a clean run's join or placement kept, made a ghost by the next mapper run: streets 128
 # and 147 of docs/check.md, 44 and 29 of 44 right against 23 and 19); else its last run.
 if [ "${REPAIR:-0}" -gt 0 ]; then
-  [ -n "$answer" ] || answer=$last
+  [ -n "$answer" ] || {
+    answer=$last
+    log "no run is clean: the loop's answer is its last run, sparse_$last, which check calls wrong ($work/check_$last.txt)"
+  }
   [ "$answer" = "$last" ] ||
     log "the $last model is not clean and the $answer model is: the loop's answer is sparse_$answer"
   echo "$answer" >"$work/answer"
@@ -309,8 +312,10 @@ for v, n in elsewhere.items():
 summary = {"extract_seconds": t_extract, "match_seconds": t_match, "ground_truth": gt or None,
            "prune": json.load(open(f"{work}/prune.json")), **rows}
 if os.path.exists(f"{work}/answer"):
-    summary["loop_answer"] = open(f"{work}/answer").read().strip()
-    print(f"the repair loop's answer: {summary['loop_answer']}")
+    answer = summary["loop_answer"] = open(f"{work}/answer").read().strip()
+    verdict = rows.get(answer, {}).get("check", "-")
+    flagged = f" (check: {verdict}; no run was clean)" if verdict not in ("clean", "-") else ""
+    print(f"the repair loop's answer: {answer}{flagged}")
 json.dump(summary, open(f"{work}/summary.json", "w"), indent=1)
 print(f"(position errors are fractions of the ground truth's extent; files: {work})")
 EOF
