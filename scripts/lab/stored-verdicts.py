@@ -84,17 +84,22 @@ def model_truth(work, model, cache):
     return cache[key]
 
 
+def lone_image(m):
+    """The image alone in a checked model's worst split, or None."""
+    one = [g[0] for g in (m.get("worst") or {}).get("groups", []) if len(g) == 1]
+    return one[0] if one else None
+
+
 def alone_row(m, threshold, truth):
     """(score, image right?, other images of the model wrong, placed elsewhere?) of a model
     whose worst split is one image alone scoring `threshold` or more, by the model's own
     truth; else None."""
-    split = m.get("worst")
-    one = [g[0] for g in (split or {}).get("groups", []) if len(g) == 1]
-    if m["score"] < threshold or not one or truth is None or one[0] not in truth:
+    one = lone_image(m)
+    if m["score"] < threshold or one is None or truth is None or one not in truth:
         return None
-    placed = one[0] in {p["image"] for p in m.get("misplaced_images", [])}
-    others = sum(not ok for n, ok in truth.items() if n != one[0])
-    return m["score"], truth[one[0]], others, placed
+    placed = one in {p["image"] for p in m.get("misplaced_images", [])}
+    others = sum(not ok for n, ok in truth.items() if n != one)
+    return m["score"], truth[one], others, placed
 
 
 def labels(work, tmp, cache):
@@ -183,7 +188,7 @@ def main(tops):
                         bands[kind, band, "true"] += links.count(True)
                         bands[kind, band, "false"] += links.count(False)
                     threshold = check["settings"]["threshold"]
-                    if m["score"] < threshold:
+                    if m["score"] < threshold or lone_image(m) is None:
                         continue
                     truth, source = model_truth(work, m["model"], truths), "model"
                     if truth is None:
