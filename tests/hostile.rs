@@ -571,3 +571,42 @@ fn pose_and_focal_computations_are_bounded_on_non_finite_matrices() {
         });
     }
 }
+
+/// Every image forbidden (`--forbid_images` naming them all): every preset refuses with its
+/// one-line error and changes no file (the fitness floor took the k-th best of no pair and
+/// panicked).
+#[test]
+fn every_image_forbidden_is_refused_by_every_preset() {
+    let (dir, db) = base(false);
+    let names: Vec<String> = Connection::open(&db)
+        .unwrap()
+        .prepare("SELECT name FROM images")
+        .unwrap()
+        .query_map([], |r| r.get(0))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    let list = dir.path().join("forbid.txt");
+    std::fs::write(&list, names.join("\n")).unwrap();
+    let before = snapshot(dir.path());
+    for preset in [
+        "general",
+        "disambiguation",
+        "disambiguation-global",
+        "paper-disambiguation",
+    ] {
+        let args = ["prune", "--database_path", s(&db), "--preset", preset];
+        let run = watchdog::run(
+            &[&args[..], &["--forbid_images", s(&list), "-q"]].concat(),
+            LIMIT,
+        );
+        sane(&run, preset);
+        assert!(!run.succeeded(), "{preset} accepted it");
+        assert!(
+            run.error_line().contains("keeps none of the"),
+            "{preset}: {:?}",
+            run.error_line()
+        );
+        assert!(snapshot(dir.path()) == before, "{preset} changed files");
+    }
+}

@@ -443,8 +443,12 @@ pub fn fitness_floor(
     if floor <= 0.0 || n == 0 {
         return floor;
     }
-    // The k-th largest of some values (k >= 1, at most their count).
+    // The k-th largest of some values (k >= 1, at most their count); without any (every
+    // image forbidden) nothing lowers the floor.
     let kth = |mut values: Vec<f64>, k: usize| {
+        if values.is_empty() {
+            return f64::INFINITY;
+        }
         let k = k.clamp(1, values.len());
         *values
             .select_nth_unstable_by(k - 1, |a, b| b.total_cmp(a))
