@@ -44,7 +44,8 @@
 #                   initial pair: an outcome, recorded as such) ends the loop, the model
 #                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
 #                   loop_answer) is its last run the check calls clean (not the pruned run
-#                   where the full model's evidence came first), else its last run
+#                   where the full model's evidence came first), else its last run, or the
+#                   full run where the pruned one made no model
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 # This checkout, or the package's copy of its scripts (/usr/share/vgsel-colmap, run as
@@ -253,10 +254,18 @@ done
 # pieces a clean run's join or placement kept, made a ghost by the next mapper run: streets 128
 # and 147 of docs/check.md, 44 and 29 of 44 right against 23 and 19); else its last run.
 if [ "${REPAIR:-0}" -gt 0 ]; then
-  [ -n "$answer" ] || {
+  if [ -n "$answer" ]; then
+    :
+  elif [ -z "$(ls -A "$work/sparse_$last")" ] && [ -n "$(ls -A "$work/sparse_full")" ]; then
+    # COLMAP 3.8 can start no model from the pruned selection (a short street's narrow pairs):
+    # the full database's model, what COLMAP alone gives, is then the answer, not nothing.
+    answer=full
+    log "the $last run made no model: the loop's answer is the full database's model, sparse_full"
+  else
     answer=$last
-    log "no run is clean: the loop's answer is its last run, sparse_$last, which check calls wrong ($work/check_$last.txt)"
-  }
+    [ -z "$(ls -A "$work/sparse_$last")" ] ||
+      log "no run is clean: the loop's answer is its last run, sparse_$last, which check calls wrong ($work/check_$last.txt)"
+  fi
   [ "$answer" = "$last" ] ||
     log "the $last model is not clean and the $answer model is: the loop's answer is sparse_$answer"
   echo "$answer" >"$work/answer"

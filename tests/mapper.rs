@@ -190,6 +190,64 @@ fn colmap_reads_the_ground_truth_model() {
     assert!(eval.max_rotation_error_deg() < 1e-4);
 }
 
+/// `scripts/pipeline.sh` where the pruned selection starts no COLMAP 3.8 model and the full
+/// database does (10 images sharing 600 points; the prune forbids the pairs of 60 inliers or
+/// more, so no pair is left that COLMAP takes as an initial one, even with its relaxed
+/// constraints): the loop's answer is the full database's model, not a run of none. About two
+/// seconds.
+#[test]
+fn the_loops_answer_is_the_full_model_where_the_pruned_selection_starts_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let (db, gt) = (dir.path().join("matched.db"), dir.path().join("gt"));
+    let spec = SceneSpec {
+        num_images: 10,
+        num_points: 600,
+        seed: 2,
+        ..SceneSpec::default()
+    };
+    write_gt_model(&generate(&spec, &db).unwrap(), &gt).unwrap();
+    let con = rusqlite::Connection::open(&db).unwrap();
+    let mut strong = String::new();
+    let mut rows = con
+        .prepare(
+            "SELECT a.name, b.name FROM two_view_geometries g \
+             JOIN images a ON a.image_id = g.pair_id / 2147483647 \
+             JOIN images b ON b.image_id = g.pair_id % 2147483647 WHERE g.rows >= 60",
+        )
+        .unwrap();
+    let pairs = rows
+        .query_map([], |r| Ok((r.get::<_, String>(0)?, r.get::<_, String>(1)?)))
+        .unwrap();
+    for pair in pairs {
+        let (a, b) = pair.unwrap();
+        strong.push_str(&format!("{a} {b}\n"));
+    }
+    let forbid = dir.path().join("strong_pairs.txt");
+    std::fs::write(&forbid, strong).unwrap();
+    let (images, work) = (dir.path().join("images"), dir.path().join("work"));
+    std::fs::create_dir_all(&images).unwrap();
+    let prune_args = format!(
+        "--preset disambiguation --forbid_pairs {}",
+        forbid.display()
+    );
+    let env = [
+        ("DATABASE", db.to_str().unwrap()),
+        ("REPAIR", "1"),
+        ("PRUNE_ARGS", prune_args.as_str()),
+    ];
+    crate::support::pipeline_sh(&images, &work, &gt, &env);
+    let read = |name: &str| std::fs::read_to_string(work.join(name)).unwrap();
+    assert!(read("mapper_pruned.log").contains("failed to create sparse model"));
+    let summary: serde_json::Value = serde_json::from_str(&read("summary.json")).unwrap();
+    assert_eq!(summary["pruned"]["models"], 0, "{summary}");
+    assert!(
+        summary["full"]["models"].as_u64().unwrap() >= 1,
+        "{summary}"
+    );
+    assert_eq!(summary["loop_answer"], "full");
+    assert_eq!(read("answer").trim(), "full");
+}
+
 /// `scripts/pipeline.sh` from a matched database (`DATABASE`) on which COLMAP 3.8 makes no
 /// model (8 images sharing 150 points: it keeps no initial pair, "failed to create sparse
 /// model"): an outcome, recorded, not a failure (a 28-image twin once stopped the pipeline
