@@ -578,16 +578,8 @@ fn pose_and_focal_computations_are_bounded_on_non_finite_matrices() {
 #[test]
 fn every_image_forbidden_is_refused_by_every_preset() {
     let (dir, db) = base(false);
-    let names: Vec<String> = Connection::open(&db)
-        .unwrap()
-        .prepare("SELECT name FROM images")
-        .unwrap()
-        .query_map([], |r| r.get(0))
-        .unwrap()
-        .map(Result::unwrap)
-        .collect();
     let list = dir.path().join("forbid.txt");
-    std::fs::write(&list, names.join("\n")).unwrap();
+    std::fs::write(&list, crate::support::image_names(&db).join("\n")).unwrap();
     let before = snapshot(dir.path());
     for preset in [
         "general",

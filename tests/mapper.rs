@@ -190,6 +190,21 @@ fn colmap_reads_the_ground_truth_model() {
     assert!(eval.max_rotation_error_deg() < 1e-4);
 }
 
+/// A generated matched database (`matched.db`, seed 2) of `num_images` cameras sharing
+/// `num_points` points in `dir`, and its ground truth (`gt`): a matched database for
+/// `pipeline.sh`'s `DATABASE`.
+fn matched_database(dir: &Path, num_images: usize, num_points: usize) -> (PathBuf, PathBuf) {
+    let (db, gt) = (dir.join("matched.db"), dir.join("gt"));
+    let spec = SceneSpec {
+        num_images,
+        num_points,
+        seed: 2,
+        ..SceneSpec::default()
+    };
+    write_gt_model(&generate(&spec, &db).unwrap(), &gt).unwrap();
+    (db, gt)
+}
+
 /// `scripts/pipeline.sh` where the pruned selection starts no COLMAP 3.8 model and the full
 /// database does (10 images sharing 600 points; the prune forbids the pairs of 60 inliers or
 /// more, so no pair is left that COLMAP takes as an initial one, even with its relaxed
@@ -198,14 +213,7 @@ fn colmap_reads_the_ground_truth_model() {
 #[test]
 fn the_loops_answer_is_the_full_model_where_the_pruned_selection_starts_none() {
     let dir = tempfile::tempdir().unwrap();
-    let (db, gt) = (dir.path().join("matched.db"), dir.path().join("gt"));
-    let spec = SceneSpec {
-        num_images: 10,
-        num_points: 600,
-        seed: 2,
-        ..SceneSpec::default()
-    };
-    write_gt_model(&generate(&spec, &db).unwrap(), &gt).unwrap();
+    let (db, gt) = matched_database(dir.path(), 10, 600);
     let con = rusqlite::Connection::open(&db).unwrap();
     let mut strong = String::new();
     let mut rows = con
@@ -256,14 +264,7 @@ fn the_loops_answer_is_the_full_model_where_the_pruned_selection_starts_none() {
 #[test]
 fn the_pipeline_records_a_run_with_no_model_and_leaves_the_matched_database_alone() {
     let dir = tempfile::tempdir().unwrap();
-    let (db, gt) = (dir.path().join("matched.db"), dir.path().join("gt"));
-    let spec = SceneSpec {
-        num_images: 8,
-        num_points: 150,
-        seed: 2,
-        ..SceneSpec::default()
-    };
-    write_gt_model(&generate(&spec, &db).unwrap(), &gt).unwrap();
+    let (db, gt) = matched_database(dir.path(), 8, 150);
     let before = std::fs::read(&db).unwrap();
     let (images, work) = (dir.path().join("images"), dir.path().join("work"));
     std::fs::create_dir_all(&images).unwrap();

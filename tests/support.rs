@@ -407,6 +407,18 @@ pub fn random_problem(
     SelectionProblem { image_costs, pairs }
 }
 
+/// The `images` table's names, by image id.
+pub fn image_names(path: &Path) -> Vec<String> {
+    Connection::open(path)
+        .unwrap()
+        .prepare("SELECT name FROM images ORDER BY image_id")
+        .unwrap()
+        .query_map([], |r| r.get(0))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect()
+}
+
 /// `vgsel_runs.user_version` of every run, oldest first.
 pub fn run_versions(path: &Path) -> Vec<Option<i64>> {
     Connection::open(path)

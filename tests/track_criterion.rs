@@ -196,14 +196,7 @@ fn the_track_length_reaches_its_share_of_the_full_graphs() {
 fn a_forbidden_image_does_not_stop_the_search() {
     // Its pairs can never be selected, so it needs nothing; the others still get theirs.
     let (dir, db) = scene();
-    let names: Vec<String> = {
-        let conn = Connection::open(&db).unwrap();
-        let mut stmt = conn
-            .prepare("SELECT name FROM images ORDER BY image_id")
-            .unwrap();
-        let rows = stmt.query_map([], |r| r.get(0)).unwrap();
-        rows.map(Result::unwrap).collect()
-    };
+    let names = crate::support::image_names(&db);
     let forbid = dir.path().join("forbid.txt");
     std::fs::write(&forbid, format!("{}\n", names[3])).unwrap();
     let (out, report) = prune(
