@@ -407,11 +407,11 @@ pub fn random_problem(
     SelectionProblem { image_costs, pairs }
 }
 
-/// The `images` table's names, by image id.
-pub fn image_names(path: &Path) -> Vec<String> {
+/// The first column of `sql`'s rows in the database at `path`.
+fn column<T: rusqlite::types::FromSql>(path: &Path, sql: &str) -> Vec<T> {
     Connection::open(path)
         .unwrap()
-        .prepare("SELECT name FROM images ORDER BY image_id")
+        .prepare(sql)
         .unwrap()
         .query_map([], |r| r.get(0))
         .unwrap()
@@ -419,16 +419,14 @@ pub fn image_names(path: &Path) -> Vec<String> {
         .collect()
 }
 
+/// The `images` table's names, by image id.
+pub fn image_names(path: &Path) -> Vec<String> {
+    column(path, "SELECT name FROM images ORDER BY image_id")
+}
+
 /// `vgsel_runs.user_version` of every run, oldest first.
 pub fn run_versions(path: &Path) -> Vec<Option<i64>> {
-    Connection::open(path)
-        .unwrap()
-        .prepare("SELECT user_version FROM vgsel_runs ORDER BY run_id")
-        .unwrap()
-        .query_map([], |r| r.get(0))
-        .unwrap()
-        .map(Result::unwrap)
-        .collect()
+    column(path, "SELECT user_version FROM vgsel_runs ORDER BY run_id")
 }
 
 /// `scripts/pipeline.sh IMAGES WORK GT` on a rendered scene as the tests run it: this build's
