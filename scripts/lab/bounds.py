@@ -48,8 +48,14 @@ def run(cmd, logfile=None, tolerated=None):
     output holds `tolerated` (an outcome, not an error)."""
     out = open(logfile, "w") if logfile else subprocess.PIPE
     p = subprocess.run(["nice", *cmd], stdout=out, stderr=subprocess.STDOUT, text=True)
+    if logfile:
+        out.close()
     if p.returncode != 0:
-        text = open(logfile).read() if logfile else p.stdout
+        if logfile:
+            with open(logfile) as f:
+                text = f.read()
+        else:
+            text = p.stdout
         if tolerated is None or tolerated not in text:
             sys.exit(f"bounds: failed: {' '.join(cmd)}\n{text[-2000:]}")
     return p.stdout
