@@ -255,7 +255,8 @@ done
 # and 147 of docs/check.md, 44 and 29 of 44 right against 23 and 19); else its last run.
 if [ "${REPAIR:-0}" -gt 0 ]; then
   if [ -n "$answer" ]; then
-    :
+    [ "$answer" = "$last" ] ||
+      log "the $last model is not clean and the $answer model is: the loop's answer is sparse_$answer"
   elif [ -z "$(ls -A "$work/sparse_$last")" ] && [ -n "$(ls -A "$work/sparse_full")" ]; then
     # COLMAP 3.8 can start no model from the pruned selection (a short street's narrow pairs):
     # the full database's model, what COLMAP alone gives, is then the answer, not nothing.
@@ -266,8 +267,6 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
     [ -z "$(ls -A "$work/sparse_$last")" ] ||
       log "no run is clean: the loop's answer is its last run, sparse_$last, which check calls wrong ($work/check_$last.txt)"
   fi
-  [ "$answer" = "$last" ] ||
-    log "the $last model is not clean and the $answer model is: the loop's answer is sparse_$answer"
   echo "$answer" >"$work/answer"
 fi
 
