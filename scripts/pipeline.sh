@@ -75,6 +75,8 @@ else
   bin=$(command -v vgsel-colmap) || { echo "pipeline: vgsel-colmap is not on PATH" >&2; exit 2; }
 fi
 log() { echo "pipeline: $*" >&2; }
+# Whether run VARIANT made a model (COLMAP 3.8 can make none: an empty sparse_VARIANT).
+made_model() { [ -n "$(ls -A "$work/sparse_$1")" ]; }
 matcher=${MATCHER:-colmap3.8} mapper=${MAPPER:-colmap3.8}
 case "$matcher/$mapper" in
   colmap3.8/colmap3.8 | */incremental | */global) ;;
@@ -198,7 +200,7 @@ last=pruned models=() earlier=() answer= full_evidence=
 # selection kept what glued it: the pruned model can be the same ghost, hidden from the check
 # (the twin: docs/check.md, "The full model in the loop", scripts/repair_loop.py), so
 # its blame joins every turn's and the loop takes its first turn.
-if [ "${REPAIR:-0}" -gt 0 ] && [ -n "$(ls -A "$work/sparse_full")" ]; then
+if [ "${REPAIR:-0}" -gt 0 ] && made_model full; then
   status=0
   "$bin" check --model "$work/sparse_full" --database_path "$work/full.db" \
     --report "$work/check_full.json" >"$work/check_full.txt" || status=$?
@@ -216,7 +218,7 @@ fi
 # place a misplaced group, join clean models or place an image no model registered).
 for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   [ "${REPAIR:-0}" -gt 0 ] || break
-  if [ -z "$(ls -A "$work/sparse_$last")" ]; then
+  if ! made_model "$last"; then
     log "the $last run made no model: nothing to check"
     break
   fi
@@ -244,7 +246,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   fi
   log "mapper again (turn $turn)"
   map_and_eval "repaired$turn"
-  if [ -z "$(ls -A "$work/sparse_repaired$turn")" ]; then
+  if ! made_model "repaired$turn"; then
     log "turn $turn made no model: the loop stops, the $last model stands"
     break
   fi
@@ -257,15 +259,16 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
   if [ -n "$answer" ]; then
     [ "$answer" = "$last" ] ||
       log "the $last model is not clean and the $answer model is: the loop's answer is sparse_$answer"
-  elif [ -z "$(ls -A "$work/sparse_$last")" ] && [ -n "$(ls -A "$work/sparse_full")" ]; then
+  elif ! made_model "$last" && made_model full; then
     # COLMAP 3.8 can start no model from the pruned selection (a short street's narrow pairs):
     # the full database's model, what COLMAP alone gives, is then the answer, not nothing.
     answer=full
     log "the $last run made no model: the loop's answer is the full database's model, sparse_full"
   else
     answer=$last
-    [ -z "$(ls -A "$work/sparse_$last")" ] ||
+    if made_model "$last"; then
       log "no run is clean: the loop's answer is its last run, sparse_$last, which check calls wrong ($work/check_$last.txt)"
+    fi
   fi
   echo "$answer" >"$work/answer"
 fi

@@ -15,9 +15,10 @@ Two tables:
               whether `eval` calls that image correct, how many other images of the model are
               wrong, and whether the report's misplaced images include it (its matches place
               it elsewhere). The truth is the model's own (`eval` on that sub-model) where the
-              ground truth is found (summary.json's, or a gt folder beside the work folder): a run's eval keeps each image's best
-              registration, and a model's wrong cameras hide behind another model's right ones.
-              Elsewhere it is the run's eval (the truth column says which).
+              ground truth is found (summary.json's, or a gt folder beside the work folder): a
+              run's eval keeps each image's best registration, and a model's wrong cameras hide
+              behind another model's right ones. Elsewhere it is the run's eval (the truth
+              column says which).
   blocked     each work folder whose answer's report lists pairs that place a lost image
               (`repair.rejoin`) that the loop blamed (its prune reports' `model_conflicts`):
               those pairs, true and false. The loop keeps them out (docs/check.md, "Lost
@@ -82,6 +83,16 @@ def model_truth(work, model, cache):
         cache[key] = {i["name"]: i["correct"] for i in json.loads(out.stdout)["images"]
                       if i.get("model") is not None}
     return cache[key]
+
+
+def run_truth(ev, m):
+    """{image name: correct?} of a checked model's images (those of its worst split) by the
+    run's eval report `ev`, each image's best registration: where the model's own is not to
+    be had."""
+    with open(ev) as f:
+        best = {i["name"]: i["correct"] for i in json.load(f)["images"]}
+    names = [n for g in (m.get("worst") or {}).get("groups", []) for n in g]
+    return {n: best[n] for n in names if n in best}
 
 
 def lone_image(m):
@@ -192,9 +203,7 @@ def main(tops):
                         continue
                     truth, source = model_truth(work, m["model"], truths), "model"
                     if truth is None:
-                        best = {i["name"]: i["correct"] for i in json.load(open(ev))["images"]}
-                        names = [n for g in (m.get("worst") or {}).get("groups", []) for n in g]
-                        truth, source = {n: best[n] for n in names if n in best}, "run"
+                        truth, source = run_truth(ev, m), "run"
                     row = alone_row(m, threshold, truth)
                     key = row and (round(row[0], 6), row[1], row[3])
                     if row is None or key in seen_alone:
