@@ -58,11 +58,13 @@ impl RunCheck<'_> {
                 blamed.insert([p.image1.clone(), p.image2.clone()]);
             }
         }
+        // The misplaced images whose matches agree on where they belong.
         let images = self
             .models
             .iter()
             .filter(|c| !c.ghost_of_groups())
-            .flat_map(|c| &c.misplaced_images);
+            .flat_map(|c| &c.misplaced_images)
+            .filter(|m| m.places());
         for pair in images.clone().flat_map(|m| &m.against) {
             blamed.insert(pair.clone());
         }

@@ -3,6 +3,7 @@
 //! walls whose cameras were registered onto one place, joined by a shared object).
 
 use super::repair::{blames, ModelEvidence};
+use super::resection::THIRD_PLACE_SHARE;
 use super::*;
 use crate::colmap::model::{ModelCamera, ModelImage};
 use crate::colmap::sparse::{Point2D, SparseImage};
@@ -1270,6 +1271,7 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
         correspondences: 100,
         model_support: 10,
         support: 90,
+        elsewhere: 0,
         moved: 0.3,
         links: vec![["c.png".into(), "b.png".into()]],
         against: vec![["c.png".into(), "d.png".into()]],
@@ -1321,6 +1323,50 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
         alone.blamed,
         [named("a.png", "c.png"), named("c.png", "d.png")]
     );
+}
+
+/// A misplaced image whose correspondences name a third place (a pose besides the model's and
+/// the matches' that [`THIRD_PLACE_SHARE`] of them agree with) is still misplaced, but the
+/// repair takes none of its pairs or matches: on a short street its best pose is one copy
+/// among several. Just under the share, it does.
+#[test]
+fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
+    let placement = |elsewhere: usize| resection::ImagePlacement {
+        image: "c.png".into(),
+        correspondences: 1000,
+        model_support: 300,
+        support: 500,
+        elsewhere,
+        moved: 0.3,
+        links: vec![["c.png".into(), "b.png".into()]],
+        against: vec![["c.png".into(), "d.png".into()]],
+        holding: vec![resection::PairMatches {
+            images: ["c.png".into(), "b.png".into()],
+            matches: vec![[3, 7]],
+        }],
+    };
+    let evidence = |m: resection::ImagePlacement| {
+        let model = ModelCheck {
+            misplaced_images: vec![m],
+            ..ModelCheck::default()
+        };
+        let wrong = model.wrong();
+        let run = RunCheck {
+            models: vec![model],
+            joins: Vec::new(),
+            rejoined: Vec::new(),
+        };
+        (wrong, run.evidence())
+    };
+    let at = (THIRD_PLACE_SHARE * 1000.0).ceil() as usize;
+    let (wrong, third) = evidence(placement(at));
+    assert!(placement(at).misplaced() && wrong);
+    assert_eq!(third, ModelEvidence::default());
+    let (_, placed) = evidence(placement(at - 1));
+    let named = |a: &str, b: &str| [a.to_string(), b.to_string()];
+    assert_eq!(placed.links, [named("b.png", "c.png")]);
+    assert_eq!(placed.blamed, [named("c.png", "d.png")]);
+    assert_eq!(placed.dropped.len(), 1);
 }
 
 /// Matches of a pair whose keypoints the model holds on different points (each point of `a` to

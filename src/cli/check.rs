@@ -233,7 +233,7 @@ fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
         d if d > 10.0 => "over 10 times the model's spread".to_string(),
         d => format!("{:.0}% of the model's spread", 100.0 * d),
     };
-    format!(
+    let text = format!(
         "; the database's matches place {} {distance} away ({} of {} correspondences agree, \
          {} with the model's pose); {} pairs place it back, {} against it, {} matches hold it \
          there",
@@ -244,7 +244,15 @@ fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
         m.links.len(),
         m.against.len(),
         m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
-    )
+    );
+    match m.places() {
+        true => text,
+        false => format!(
+            "{text}; {} more agree with a third pose: it matches a third place, and the \
+             repair takes none of its pairs",
+            m.elsewhere
+        ),
+    }
 }
 
 /// Where the database's matches place a model's second group, and the pairs that link it.
