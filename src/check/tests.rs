@@ -1582,6 +1582,63 @@ fn an_image_the_mapper_lost_is_placed_by_its_true_pairs() {
     assert!(run.rejoined.is_empty());
 }
 
+/// A wall whose texture repeats every metre (copy `c`'s point `k` has id `1000 c + k`), twelve
+/// images along it, the last taken out as a mapper that lost it leaves it, with its true pairs
+/// to images 5-8 and, with `copies`, pairs to images 9-11 whose matches are the next copy's
+/// look: a second place, one metre on, that those matches agree with. A lost image whose
+/// matches name two places is not placed (a lost street camera's matches put it on every
+/// copy); with its true pairs alone it is.
+#[test]
+fn a_lost_image_whose_matches_name_a_second_place_is_not_placed() {
+    let mut rng = Lcg(5);
+    let texture: Vec<[f64; 2]> = (0..250)
+        .map(|_| [rng.next(), 4.0 * rng.next() - 2.0])
+        .collect();
+    let points: Vec<(u64, [f64; 3])> = (0..10u64)
+        .flat_map(|c| {
+            let x0 = c as f64 - 5.0;
+            texture
+                .iter()
+                .enumerate()
+                .map(move |(k, t)| (1000 * c + k as u64, [x0 + t[0], t[1], 5.0]))
+        })
+        .collect();
+    let mut images: Vec<SparseImage> = (0..12)
+        .map(|k| image(k + 1, -3.0 + 0.5 * k as f64, &points, 0.6, &mut rng))
+        .collect();
+    let lost = images.pop().expect("12 images");
+    let model = model(images, &points);
+    let placed = |copies: bool| {
+        let mut evidence = Evidence::default();
+        for a in &model.images[4..8] {
+            add_pair(&mut evidence, a, &lost, matches_of(a, &lost, |id| id));
+        }
+        if copies {
+            for a in &model.images[8..] {
+                let next_copy = matches_of(a, &lost, |id| id.wrapping_sub(1000));
+                add_pair(&mut evidence, a, &lost, next_copy);
+            }
+        }
+        let image = evidence::LostImage {
+            camera_id: 1,
+            camera: camera(),
+            keypoints: lost.points2d.iter().map(|p| p.xy).collect(),
+            matches: Vec::new(),
+        };
+        evidence.lost_images.insert(lost.image.name.clone(), image);
+        evidence.gather_lost_matches();
+        let models = std::slice::from_ref(&model);
+        let run = check_run(models, Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+        assert!(!run.models[0].wrong());
+        run.rejoined
+    };
+    let [alone] = &placed(false)[..] else {
+        panic!("the lost image placed by its true pairs")
+    };
+    assert_eq!(alone.image, "0012.png");
+    assert!(placed(true).is_empty());
+}
+
 /// Lost are the images with a verified pair of enough inliers that no model registered,
 /// whether a prune invalidated their pairs (the selection left them out) or not.
 #[test]
