@@ -55,8 +55,8 @@ pub const MAX_MOVED: f64 = 2.5;
 pub const HOLDING_FAR: f64 = 0.15;
 /// An image's matches place it (a misplaced image, for the repair; a lost image, at all) only
 /// where no third place holds this share of its correspondences: the best pose among those
-/// that neither the model's pose nor the matches' explains (for a lost image, those the
-/// matches' pose does not). A misplaced image matches two places, where the model put it and
+/// that neither the model's pose nor the matches' explains (for a lost image, those that
+/// neither the matches' pose nor the best pose of the rest, its other copy, explains). A misplaced image matches two places, where the model put it and
 /// where it belongs; on a short street, whose every view matches every building, it matches
 /// more, and the best pose is one copy among several (session 43, 25 misplaced images of
 /// streets with COLMAP 3.8: a third place held 0.02-0.33 of their correspondences, and the
@@ -255,8 +255,9 @@ impl<'a> Frame<'a> {
 /// Places `name`, which no model registered, in `frame` by its matches to keypoints on the
 /// model's points, through the model's camera of its camera_id (refined) or else the
 /// database's: the pose most of them agree with, where at least [`MIN_SUPPORT`] do (COLMAP's
-/// mapper registers an image with 30 inliers, `abs_pose_min_num_inliers`) and no second place
-/// holds [`THIRD_PLACE_SHARE`] of them (a lost street camera's matches put it on every copy).
+/// mapper registers an image with 30 inliers, `abs_pose_min_num_inliers`) and no third place
+/// holds [`THIRD_PLACE_SHARE`] of them, beside that pose and the best of the rest (its other
+/// copy): a lost street camera's matches put it on every copy.
 pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option<Rejoin>> {
     let views = frame.views;
     // In view order, as a registered image's correspondences are (the RANSAC's draws follow it).
@@ -300,7 +301,13 @@ pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option
         }
     }
     let support = per_view.values().map(|n| n[1]).sum();
-    if support < MIN_SUPPORT || !one_place(best_support(views, &intrinsics, &rest)?, c.len()) {
+    if support < MIN_SUPPORT {
+        return Ok(None);
+    }
+    // Its other copy may be a second place (the demo's first image, left out, matches both
+    // objects); a third is a street's.
+    let (_, rest) = best_pose(views, &intrinsics, &rest)?;
+    if !one_place(best_pose(views, &intrinsics, &rest)?.0, c.len()) {
         return Ok(None);
     }
     let mut links = Vec::new();
@@ -318,19 +325,24 @@ pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option
     }))
 }
 
-/// How many of correspondences `c` the pose most of them agree with explains (0 where fewer
-/// than [`MIN_SUPPORT`] are left to give one).
-fn best_support(views: &Views, intrinsics: &Intrinsics, c: &[Correspondence]) -> Result<usize> {
-    if c.len() < MIN_SUPPORT {
-        return Ok(0);
-    }
-    let Some((rotation, translation)) = pnp(views, intrinsics, c)? else {
-        return Ok(0);
+/// How many of correspondences `c` the pose most of them agree with explains, and those it
+/// leaves (none explained where fewer than [`MIN_SUPPORT`] are there to give one).
+fn best_pose(
+    views: &Views,
+    intrinsics: &Intrinsics,
+    c: &[Correspondence],
+) -> Result<(usize, Vec<Correspondence>)> {
+    let pose = match c.len() < MIN_SUPPORT {
+        true => None,
+        false => pnp(views, intrinsics, c)?,
+    };
+    let Some((rotation, translation)) = pose else {
+        return Ok((0, c.to_vec()));
     };
     let pose = (&rotation, &translation);
-    Ok((c.iter())
-        .filter(|k| reprojection_error(views, intrinsics, pose, k) <= AGREE_PX)
-        .count())
+    let (agree, rest): (Vec<_>, Vec<_>) =
+        (c.iter()).partition(|k| reprojection_error(views, intrinsics, pose, k) <= AGREE_PX);
+    Ok((agree.len(), rest))
 }
 
 /// A world-to-camera rotation and translation.
@@ -384,7 +396,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
             last.2.push(matched);
         }
     }
-    let elsewhere = best_support(views, &view.intrinsics, &rest)?;
+    let elsewhere = best_pose(views, &view.intrinsics, &rest)?.0;
     let moved = (-(rotation.transpose() * translation) - view.centre).norm() / spread;
     let named = |w: usize| [view.name.clone(), views.views[w].name.clone()];
     let judged = pairs.iter().filter(|p| p.1[0] >= PAIR_MIN_CORRESPONDENCES);

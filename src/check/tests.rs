@@ -1584,12 +1584,13 @@ fn an_image_the_mapper_lost_is_placed_by_its_true_pairs() {
 
 /// A wall whose texture repeats every metre (copy `c`'s point `k` has id `1000 c + k`), twelve
 /// images along it, the last taken out as a mapper that lost it leaves it, with its true pairs
-/// to images 5-8 and, with `copies`, pairs to images 9-11 whose matches are the next copy's
-/// look: a second place, one metre on, that those matches agree with. A lost image whose
-/// matches name two places is not placed (a lost street camera's matches put it on every
-/// copy); with its true pairs alone it is.
+/// to images 5-8, then pairs to images 9 and 10 whose matches are the next copy's look (a
+/// second place, one metre on: its other copy), then one to image 11 whose matches are the
+/// look of the copy two metres on (a third place). A lost image whose matches name a third
+/// place is not placed (a lost street camera's matches put it on every copy); with its true
+/// pairs alone, or beside its other copy, it is.
 #[test]
-fn a_lost_image_whose_matches_name_a_second_place_is_not_placed() {
+fn a_lost_image_whose_matches_name_a_third_place_is_not_placed() {
     let mut rng = Lcg(5);
     let texture: Vec<[f64; 2]> = (0..250)
         .map(|_| [rng.next(), 4.0 * rng.next() - 2.0])
@@ -1608,16 +1609,18 @@ fn a_lost_image_whose_matches_name_a_second_place_is_not_placed() {
         .collect();
     let lost = images.pop().expect("12 images");
     let model = model(images, &points);
-    let placed = |copies: bool| {
+    let placed = |copies: usize| {
         let mut evidence = Evidence::default();
         for a in &model.images[4..8] {
             add_pair(&mut evidence, a, &lost, matches_of(a, &lost, |id| id));
         }
-        if copies {
-            for a in &model.images[8..] {
-                let next_copy = matches_of(a, &lost, |id| id.wrapping_sub(1000));
-                add_pair(&mut evidence, a, &lost, next_copy);
-            }
+        for (a, copy) in model.images[8..]
+            .iter()
+            .zip([1000, 1000, 2000])
+            .take(copies)
+        {
+            let other_copy = matches_of(a, &lost, |id| id.wrapping_sub(copy));
+            add_pair(&mut evidence, a, &lost, other_copy);
         }
         let image = evidence::LostImage {
             camera_id: 1,
@@ -1632,11 +1635,13 @@ fn a_lost_image_whose_matches_name_a_second_place_is_not_placed() {
         assert!(!run.models[0].wrong());
         run.rejoined
     };
-    let [alone] = &placed(false)[..] else {
-        panic!("the lost image placed by its true pairs")
-    };
-    assert_eq!(alone.image, "0012.png");
-    assert!(placed(true).is_empty());
+    for copies in [0, 2] {
+        let [r] = &placed(copies)[..] else {
+            panic!("the lost image placed, {copies} pairs to the next copy")
+        };
+        assert_eq!(r.image, "0012.png");
+    }
+    assert!(placed(3).is_empty());
 }
 
 /// Lost are the images with a verified pair of enough inliers that no model registered,
