@@ -1540,6 +1540,13 @@ fn lost_image(mut model: SparseModel) -> (SparseModel, Evidence) {
         &lost,
         refused_matches(&model.images[0], &lost),
     );
+    add_lost(&mut evidence, &lost);
+    (model, evidence)
+}
+
+/// `lost` as a mapper that did not register it leaves it in `evidence`: its keypoints, and its
+/// matches gathered from the pairs added.
+fn add_lost(evidence: &mut Evidence, lost: &SparseImage) {
     let image = evidence::LostImage {
         camera_id: 1,
         camera: camera(),
@@ -1548,7 +1555,6 @@ fn lost_image(mut model: SparseModel) -> (SparseModel, Evidence) {
     };
     evidence.lost_images.insert(lost.image.name.clone(), image);
     evidence.gather_lost_matches();
-    (model, evidence)
 }
 
 /// An image no model registered is placed by its matches to the model's points: the pairs
@@ -1622,14 +1628,7 @@ fn a_lost_image_whose_matches_name_a_third_place_is_not_placed() {
             let other_copy = matches_of(a, &lost, |id| id.wrapping_sub(copy));
             add_pair(&mut evidence, a, &lost, other_copy);
         }
-        let image = evidence::LostImage {
-            camera_id: 1,
-            camera: camera(),
-            keypoints: lost.points2d.iter().map(|p| p.xy).collect(),
-            matches: Vec::new(),
-        };
-        evidence.lost_images.insert(lost.image.name.clone(), image);
-        evidence.gather_lost_matches();
+        add_lost(&mut evidence, &lost);
         let models = std::slice::from_ref(&model);
         let run = check_run(models, Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
         assert!(!run.models[0].wrong());
