@@ -56,9 +56,10 @@ pub const HOLDING_FAR: f64 = 0.15;
 /// An image's matches place it (a misplaced image, for the repair; a lost image, at all) only
 /// where no third place holds this share of its correspondences: the best pose among those
 /// that neither the model's pose nor the matches' explains (for a lost image, those that
-/// neither the matches' pose nor the best pose of the rest, its other copy, explains). A misplaced image matches two places, where the model put it and
-/// where it belongs; on a short street, whose every view matches every building, it matches
-/// more, and the best pose is one copy among several (session 43, 25 misplaced images of
+/// neither the matches' pose nor the best pose of the rest, its other copy, explains). A
+/// misplaced image matches two places, where the model put it and where it belongs; on a
+/// short street, whose every view matches every building, it matches more, and the best pose
+/// is one copy among several (session 43, 25 misplaced images of
 /// streets with COLMAP 3.8: a third place held 0.02-0.33 of their correspondences, and the
 /// pairs that placed them were 42 true of 207; the demo design's three misplaced cameras with
 /// the global mapper, 0.00, their 22 pairs all true; docs/check.md). Noise does not agree on
@@ -81,7 +82,8 @@ pub struct ImagePlacement {
     /// Those the matches' pose projects within [`AGREE_PX`].
     pub support: usize,
     /// Of the rest (neither pose projects them within [`AGREE_PX`]), those the best pose
-    /// among them does: a third place the image matches ([`THIRD_PLACE_SHARE`]).
+    /// among them does: a third place the image matches ([`THIRD_PLACE_SHARE`]). Sought for
+    /// a misplaced image only (0 for the others): nothing else asks.
     pub elsewhere: usize,
     /// How far the matches' pose moves the camera centre, over the model's spread (the median
     /// distance of its points to their centroid).
@@ -396,7 +398,6 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
             last.2.push(matched);
         }
     }
-    let elsewhere = best_pose(views, &view.intrinsics, &rest)?.0;
     let moved = (-(rotation.transpose() * translation) - view.centre).norm() / spread;
     let named = |w: usize| [view.name.clone(), views.views[w].name.clone()];
     let judged = pairs.iter().filter(|p| p.1[0] >= PAIR_MIN_CORRESPONDENCES);
@@ -416,17 +417,22 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
             matches,
         })
         .collect();
-    Ok(Some(ImagePlacement {
+    let mut placement = ImagePlacement {
         image: view.name.clone(),
         correspondences: c.len(),
         model_support,
         support,
-        elsewhere,
+        elsewhere: 0,
         moved,
         links,
         against,
         holding,
-    }))
+    };
+    // A second RANSAC, for the few images it concerns.
+    if placement.misplaced() {
+        placement.elsewhere = best_pose(views, &view.intrinsics, &rest)?.0;
+    }
+    Ok(Some(placement))
 }
 
 /// The pose most correspondences `c` (to `views`' points, through intrinsics `i`) agree with:
