@@ -3,7 +3,7 @@
 //! walls whose cameras were registered onto one place, joined by a shared object).
 
 use super::repair::{blames, ModelEvidence};
-use super::resection::THIRD_PLACE_SHARE;
+use super::resection::{DOMINANT_SUPPORT, THIRD_PLACE_SHARE};
 use super::*;
 use crate::colmap::model::{ModelCamera, ModelImage};
 use crate::colmap::sparse::{Point2D, SparseImage};
@@ -1328,7 +1328,8 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
 /// A misplaced image whose correspondences name a third place (a pose besides the model's and
 /// the matches' that [`THIRD_PLACE_SHARE`] of them agree with) is still misplaced, but the
 /// repair takes none of its pairs or matches: on a short street its best pose is one copy
-/// among several. Just under the share, it does.
+/// among several. Just under the share it does, and where the matches' pose holds
+/// [`DOMINANT_SUPPORT`] times the model's and the third's (a hall camera on the other orbit).
 #[test]
 fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
     let placement = |elsewhere: usize| resection::ImagePlacement {
@@ -1367,6 +1368,23 @@ fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
     assert_eq!(placed.links, [named("b.png", "c.png")]);
     assert_eq!(placed.blamed, [named("c.png", "d.png")]);
     assert_eq!(placed.dropped.len(), 1);
+    // A third place at the share, the matches' pose holding DOMINANT_SUPPORT times the model's
+    // and the third's (the larger of the two, in turn): placed; one correspondence fewer: not.
+    for (model_support, elsewhere) in [(100, at), (at, 100), (200, 200)] {
+        let held = (DOMINANT_SUPPORT * model_support.max(elsewhere) as f64).ceil() as usize;
+        let with = |support: usize| resection::ImagePlacement {
+            model_support,
+            support,
+            ..placement(elsewhere)
+        };
+        assert!(with(held).third_place() && with(held).misplaced());
+        assert_eq!(
+            evidence(with(held)).1,
+            placed,
+            "{model_support} {elsewhere}"
+        );
+        assert_eq!(evidence(with(held - 1)).1, ModelEvidence::default());
+    }
 }
 
 /// Matches of a pair whose keypoints the model holds on different points (each point of `a` to

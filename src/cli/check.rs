@@ -245,12 +245,16 @@ fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
         m.against.len(),
         m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
     );
-    match m.places() {
-        true => text,
-        false => format!(
-            "{text}; {} more agree with a third pose: it matches a third place, and the \
-             repair takes none of its pairs",
-            m.elsewhere
+    let third = format!("; {} more agree with a third pose", m.elsewhere);
+    match (m.third_place(), m.dominates()) {
+        (false, _) => text,
+        (true, true) => format!(
+            "{text}{third}, but the matches' pose holds {:.1} times the model's and the third's: \
+             the repair takes its pairs",
+            m.support as f64 / m.model_support.max(m.elsewhere) as f64
+        ),
+        (true, false) => format!(
+            "{text}{third}: it matches a third place, and the repair takes none of its pairs"
         ),
     }
 }
