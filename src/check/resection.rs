@@ -71,10 +71,11 @@ pub const THIRD_PLACE_SHARE: f64 = 0.05;
 /// building, and its copies hold alike: the matches' pose held 1.21 to 2.63 times the larger
 /// of the other two for the 79 misplaced street cameras with a third place in sessions
 /// 43-44's loops (15 streets, COLMAP 3.8 and 4.2's incremental mapper; their links 211 true of
-/// 801); a hall camera put on the other object's orbit held 3.55 times (0023 in a CI run of
-/// session 44: 1226 correspondences, 345 with the model's pose and 328 with a third; its 15
-/// links all true; docs/check.md).
-pub const DOMINANT_SUPPORT: f64 = 3.0;
+/// 801); a hall camera put on the other object's orbit held 3.55 and 3.19 times (0023 in two
+/// matchings of the test's hall, session 44's CI and session 45: 1226 and 1244
+/// correspondences, 345 and 390 with the model's pose, 328 and 297 with a third; its 15 links
+/// all true). Midway: 2.9 (docs/check.md).
+pub const DOMINANT_SUPPORT: f64 = 2.9;
 /// A pair of a misplaced image is judged (a link or against it) with at least this many
 /// correspondences.
 pub const PAIR_MIN_CORRESPONDENCES: usize = 5;
