@@ -531,6 +531,45 @@ mod tests {
         }
     }
 
+    /// A misplaced image's line says what the repair does with its pairs: takes them where its
+    /// matches name no third place or their pose dominates it, else none.
+    #[test]
+    fn a_misplaced_images_line_says_whether_the_repair_takes_its_pairs() {
+        let placed = |support: usize, model_support: usize, elsewhere: usize| {
+            misplaced_image_text(&check::resection::ImagePlacement {
+                image: "c.png".into(),
+                correspondences: 1000,
+                model_support,
+                support,
+                elsewhere,
+                moved: 2.4,
+                links: vec![["c.png".into(), "b.png".into()]],
+                against: Vec::new(),
+                holding: Vec::new(),
+            })
+        };
+        let head = "; the database's matches place c.png 240% of the model's spread away";
+        assert_eq!(
+            placed(600, 200, 10),
+            format!(
+                "{head} (600 of 1000 correspondences agree, 200 with the model's pose); 1 pairs \
+                 place it back, 0 against it, 0 matches hold it there"
+            )
+        );
+        let refused = |elsewhere: usize| {
+            format!(
+                "; {elsewhere} more agree with a third pose: it matches a third place, and the \
+                 repair takes none of its pairs"
+            )
+        };
+        assert!(placed(500, 200, 100).ends_with(&refused(100)));
+        assert!(placed(869, 300, 200).ends_with(&refused(200)));
+        assert!(placed(870, 300, 200).ends_with(
+            "; 200 more agree with a third pose, but the matches' pose holds 2.9 times the \
+             model's and the third's: the repair takes its pairs"
+        ));
+    }
+
     /// A model without points says so instead of a score and groups it never judged.
     #[test]
     fn a_model_without_points_is_said_to_have_none() {
