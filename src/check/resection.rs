@@ -138,8 +138,8 @@ impl ImagePlacement {
     }
 
     /// Its matches name no third place ([`ImagePlacement::third_place`]), or their pose
-    /// dominates the others ([`ImagePlacement::dominates`]): where the image is misplaced, the matches' pose
-    /// is where it belongs.
+    /// dominates the others ([`ImagePlacement::dominates`]): where the image is misplaced,
+    /// the matches' pose is where it belongs.
     pub fn places(&self) -> bool {
         !self.third_place() || self.dominates()
     }
@@ -153,7 +153,13 @@ impl ImagePlacement {
     /// The matches' pose holds [`DOMINANT_SUPPORT`] times the correspondences of the model's
     /// pose and of the third place.
     pub fn dominates(&self) -> bool {
-        self.support as f64 >= DOMINANT_SUPPORT * self.model_support.max(self.elsewhere) as f64
+        self.dominance() >= DOMINANT_SUPPORT
+    }
+
+    /// The correspondences the matches' pose holds over the larger of those the model's pose
+    /// and the third place hold.
+    pub fn dominance(&self) -> f64 {
+        self.support as f64 / self.model_support.max(self.elsewhere) as f64
     }
 }
 

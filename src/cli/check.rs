@@ -251,7 +251,7 @@ fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
         (true, true) => format!(
             "{text}{third}, but the matches' pose holds {:.1} times the model's and the third's: \
              the repair takes its pairs",
-            m.support as f64 / m.model_support.max(m.elsewhere) as f64
+            m.dominance()
         ),
         (true, false) => format!(
             "{text}{third}: it matches a third place, and the repair takes none of its pairs"
