@@ -80,6 +80,18 @@ def pair_labels(path):
                 for r in csv.DictReader(f)}
 
 
+def named_pair_labels(full_db, gt, tmp):
+    """{(name, name) sorted: true?} for every verified pair of `full_db` by `eval --labels`
+    against ground truth `gt`: exact for rendered scenes (their scene.json); the CSV in `tmp`."""
+    path = os.path.join(tmp, "labels.csv")
+    subprocess.run([VGSEL, "eval", "--model", gt, "--ground_truth", gt, "--database_path",
+                    full_db, "--labels", path], capture_output=True, check=True)
+    names, _ = view_graph(full_db)
+    return {tuple(sorted((names[a], names[b]))): truth
+            for (a, b), truth in pair_labels(path).items()
+            if a in names and b in names}
+
+
 def component_sizes(nodes, pairs):
     """Sizes of the connected components of the graph of `nodes` under `pairs`."""
     parent = {n: n for n in nodes}

@@ -53,18 +53,6 @@ def placements(work, tmp):
             yield row
 
 
-def labels(full_db, gt, tmp):
-    """{(name, name) sorted: true?} for every verified pair of the run, exact for rendered
-    scenes."""
-    path = os.path.join(tmp, "labels.csv")
-    subprocess.run([VGSEL, "eval", "--model", gt, "--ground_truth", gt, "--database_path",
-                    full_db, "--labels", path], capture_output=True, check=True)
-    names, _ = colmap_files.view_graph(full_db)
-    return {tuple(sorted((names[a], names[b]))): truth
-            for (a, b), truth in colmap_files.pair_labels(path).items()
-            if a in names and b in names}
-
-
 def sourced_pairs(report):
     """(source, (name, name) sorted) for every pair the report's evidence names."""
     key = lambda a, b: tuple(sorted((a, b)))
@@ -123,7 +111,7 @@ def main():
             seen = {}
             for model, db, full_db, gt in turns(work):
                 if full_db not in seen:
-                    seen[full_db] = labels(full_db, gt, tmp)
+                    seen[full_db] = colmap_files.named_pair_labels(full_db, gt, tmp)
                 path = os.path.join(tmp, "check.json")
                 subprocess.run([VGSEL, "check", "-q", "--model", model, "--database_path", db,
                                 "--report", path], capture_output=True)
