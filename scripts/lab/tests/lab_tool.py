@@ -1,5 +1,6 @@
 """Runs one of the lab's scripts as a user would, for the lab's tests."""
 import os
+import stat
 import subprocess
 import sys
 
@@ -15,3 +16,11 @@ def run(script, *args):
         raise AssertionError(f"{script} {' '.join(map(str, args))} failed ({out.returncode}):\n"
                              f"{out.stdout}\n{out.stderr}")
     return out.stdout
+
+
+def write_executable(path, text):
+    """Writes `text` to `path` as an executable: a stand-in binary for a lab test."""
+    with open(path, "w") as f:
+        f.write(text)
+    os.chmod(path, os.stat(path).st_mode | stat.S_IEXEC)
+    return path

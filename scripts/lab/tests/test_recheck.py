@@ -3,7 +3,6 @@ every run found at any depth (those with a database and a model), only the rows 
 or score moved printed, the counts by truth and exit status before and after."""
 import json
 import os
-import stat
 import tempfile
 import unittest
 from unittest import mock
@@ -28,11 +27,8 @@ class Recheck(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             binaries = {}
             for name in ("before", "after"):
-                path = os.path.join(tmp, name)
-                with open(path, "w") as f:
-                    f.write(FAKE.format(name=name))
-                os.chmod(path, os.stat(path).st_mode | stat.S_IEXEC)
-                binaries[name] = path
+                binaries[name] = lab_tool.write_executable(os.path.join(tmp, name),
+                                                           FAKE.format(name=name))
             # Two pipeline work folders, one nested deeper; a run without a model is skipped.
             runs = {"a/c38": {"full": (0.9, 0.9, 10, 10), "pruned": (0.2, 0.6, 8, 10)},
                     "b/x/g42": {"full": (0.1, 0.1, 10, 10)}}

@@ -4,7 +4,6 @@ support over the larger of the model's and the third's), its links against the l
 range per design with and without a third place."""
 import json
 import os
-import stat
 import tempfile
 import unittest
 from unittest import mock
@@ -40,10 +39,7 @@ def placement(correspondences, support, model_support, elsewhere, links):
 class ThirdPlace(unittest.TestCase):
     def test_cameras_and_ranges(self):
         with tempfile.TemporaryDirectory() as tmp:
-            fake = os.path.join(tmp, "vgsel")
-            with open(fake, "w") as f:
-                f.write(FAKE)
-            os.chmod(fake, os.stat(fake).st_mode | stat.S_IEXEC)
+            fake = lab_tool.write_executable(os.path.join(tmp, "vgsel"), FAKE)
             # Two runs of one street loop (the pruned run's camera repeated in the first
             # turn), one run of a hall loop.
             runs = {
