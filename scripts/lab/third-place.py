@@ -42,7 +42,8 @@ def cameras(dirs, tmp):
             full_db = f"{work}/full.db"
             if not gt or not os.path.exists(full_db):
                 continue
-            design = os.path.basename(os.path.dirname(gt.rstrip("/").rsplit("/gt", 1)[0]))
+            # GT is SCENE_FOLDER/scene/gt: the scene folder names the design.
+            design = os.path.basename(os.path.dirname(os.path.dirname(gt.rstrip("/"))))
             for model, db, _ in colmap_files.pipeline_runs(work):
                 report = os.path.join(tmp, "check.json")
                 subprocess.run([VGSEL, "check", "-q", "--model", model, "--database_path", db,
