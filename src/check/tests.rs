@@ -943,6 +943,69 @@ fn joins_of_a_split(model: &SparseModel, in_b: impl Fn(&SparseImage) -> bool) ->
     .unwrap()
 }
 
+/// Like the street design: one facade's texture on twelve buildings a metre apart, twelve
+/// cameras walking past, mapped as two pieces (images 1-6 and 7-12, the second in another
+/// frame) that an earlier run's ghost had put onto each other. Their true matches place them;
+/// where each view also matches the next building's look (`next_copy`), the rest of the
+/// matches place the second piece a building on, and the check cannot refute that either:
+/// two places, and the pieces are not joined.
+#[test]
+fn two_pieces_whose_matches_also_place_them_a_copy_on_are_not_joined() {
+    const OFFSET: u64 = 100_000;
+    let mut rng = Lcg(11);
+    let texture: Vec<[f64; 2]> = (0..250)
+        .map(|_| [rng.next(), 4.0 * rng.next() - 2.0])
+        .collect();
+    let points: Vec<(u64, [f64; 3])> = (0..12u64)
+        .flat_map(|c| {
+            let x0 = c as f64 - 6.0;
+            texture
+                .iter()
+                .enumerate()
+                .map(move |(k, t)| (1000 * c + k as u64, [x0 + t[0], t[1], 5.0]))
+        })
+        .collect();
+    let images = (0..12)
+        .map(|k| image(k + 1, -3.0 + 0.5 * k as f64, &points, 0.6, &mut rng))
+        .collect();
+    let street = model(images, &points);
+    let (a, b) = two_models(&street, |im| im.image.image_id > 6, OFFSET, &elsewhere());
+    let names = |m: &SparseModel| m.images.iter().map(|im| im.image.name.clone()).collect();
+    let ghost = SparseModel {
+        images: [a.images.clone(), b.images.clone()].concat(),
+        ..SparseModel::default()
+    };
+    let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
+    let joins = |next_copy: bool| {
+        let mut evidence = matches_between(&a, &b, OFFSET);
+        if next_copy {
+            for (ia, ib) in a
+                .images
+                .iter()
+                .flat_map(|ia| b.images.iter().map(move |ib| (ia, ib)))
+            {
+                let m = matches_of(ia, ib, |id| id + 1000 + OFFSET);
+                let key = (ia.image.name.clone(), ib.image.name.clone());
+                evidence.matches.get_mut(&key).unwrap().extend(m);
+            }
+        }
+        let pair = [(&a, false), (&b, false)];
+        join::join_models(
+            &pair,
+            &evidence,
+            &DEFAULT_SETTINGS,
+            std::slice::from_ref(&glued),
+        )
+        .unwrap()
+    };
+    let joined = joins(false);
+    assert_eq!(joined.len(), 1, "{joined:?}");
+    let (p, back) = (&joined[0].placement, back_from_elsewhere());
+    assert!((p.scale - back.scale).abs() < 1e-6 * back.scale, "{p:?}");
+    let two_places = joins(true);
+    assert!(two_places.is_empty(), "{two_places:?}");
+}
+
 const HALL_OFFSET: u64 = 100_000;
 
 /// Like the hall design: two identical objects in front of one wall, six cameras walking past
