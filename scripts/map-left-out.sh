@@ -5,8 +5,11 @@
 # `check --model`, `eval` and `prune --model` read them as part of the same run. COLMAP 3.8
 # relaxes its initial pair only while it has no model at all, so a piece that `prune --model`
 # cut off and whose neighbours see their surroundings under small angles starts no model of its
-# own (docs/check.md, "Pieces that start no model"). COLMAP 4 needs none of this: its
-# incremental mapper relaxes while images are left, its global mapper has no initial pair.
+# own (docs/check.md, "Pieces that start no model"). Pieces of 3 images or more are kept
+# (`--Mapper.min_model_size 3`): COLMAP drops a model of fewer than 10, and a street's left-out
+# images can map as pieces of 4 to 9 each, every one dropped, leaving no model at all (docs/
+# check.md, "Pieces smaller than ten images"). COLMAP 4 needs none of this: its incremental
+# mapper relaxes while images are left, its global mapper has no initial pair.
 #
 # usage: scripts/map-left-out.sh DB IMAGES SPARSE [MAPPER_OPTION ...]
 #   DB       the database the turn's mapper ran on
@@ -18,7 +21,7 @@
 # Prints how many images it gave the mapper. Environment: VGSEL, the vgsel-colmap binary
 # [vgsel-colmap on PATH].
 set -euo pipefail
-[ $# -ge 3 ] || { sed -n '11,20p' "$0" >&2; exit 2; }
+[ $# -ge 3 ] || { sed -n '14,22p' "$0" >&2; exit 2; }
 db=$1 images=$2 sparse=$3
 shift 3
 bin=${VGSEL:-vgsel-colmap}
@@ -39,7 +42,7 @@ mkdir -p "$sparse/left"
 # COLMAP 3.8 exits 1 where the images start no model (one image alone, or no initial pair even
 # relaxed): the run then stays as it was.
 if ! colmap mapper --database_path "$db" --image_path "$images" --output_path "$sparse/left" \
-  --image_list_path "$list" "$@" >"$sparse.left.log" 2>&1 &&
+  --image_list_path "$list" --Mapper.min_model_size 3 "$@" >"$sparse.left.log" 2>&1 &&
   ! grep -q "failed to create sparse model" "$sparse.left.log"; then
   tail -n 20 "$sparse.left.log" >&2
   echo "map-left-out: colmap mapper failed (log: $sparse.left.log)" >&2

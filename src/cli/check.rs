@@ -317,7 +317,8 @@ fn earlier_ghosts(
 fn unregistered_line(names: &[String]) -> String {
     format!(
         "{} images the database's pairs link are in no model: {} (with COLMAP 3.8, map them \
-         on their own: --unregistered FILE, then colmap mapper --image_list_path FILE)",
+         on their own: --unregistered FILE, then colmap mapper --image_list_path FILE \
+         --Mapper.min_model_size 3)",
         names.len(),
         listed(names)
     )
