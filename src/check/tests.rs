@@ -90,6 +90,24 @@ fn image_at(
     image
 }
 
+/// One facade's texture (250 points, a metre wide, on z = 5) on `copies` buildings a metre
+/// apart, centred on x = 0: a street of identical buildings, point ids 1000 per building.
+fn facades(rng: &mut Lcg, copies: u64) -> Vec<(u64, [f64; 3])> {
+    let texture: Vec<[f64; 2]> = (0..250)
+        .map(|_| [rng.next(), 4.0 * rng.next() - 2.0])
+        .collect();
+    (0..copies)
+        .flat_map(|c| {
+            let x0 = c as f64 - copies as f64 / 2.0;
+            texture
+                .iter()
+                .map(move |t| [x0 + t[0], t[1], 5.0])
+                .enumerate()
+                .map(move |(k, p)| (1000 * c + k as u64, p))
+        })
+        .collect()
+}
+
 fn model(images: Vec<SparseImage>, points: &[(u64, [f64; 3])]) -> SparseModel {
     SparseModel {
         cameras: vec![camera()],
@@ -953,18 +971,7 @@ fn joins_of_a_split(model: &SparseModel, in_b: impl Fn(&SparseImage) -> bool) ->
 fn two_pieces_whose_matches_also_place_them_a_copy_on_are_not_joined() {
     const OFFSET: u64 = 100_000;
     let mut rng = Lcg(11);
-    let texture: Vec<[f64; 2]> = (0..250)
-        .map(|_| [rng.next(), 4.0 * rng.next() - 2.0])
-        .collect();
-    let points: Vec<(u64, [f64; 3])> = (0..12u64)
-        .flat_map(|c| {
-            let x0 = c as f64 - 6.0;
-            texture
-                .iter()
-                .enumerate()
-                .map(move |(k, t)| (1000 * c + k as u64, [x0 + t[0], t[1], 5.0]))
-        })
-        .collect();
+    let points = facades(&mut rng, 12);
     let images = (0..12)
         .map(|k| image(k + 1, -3.0 + 0.5 * k as f64, &points, 0.6, &mut rng))
         .collect();
@@ -1679,18 +1686,7 @@ fn an_image_the_mapper_lost_is_placed_by_its_true_pairs() {
 #[test]
 fn a_lost_image_whose_matches_name_a_third_place_is_not_placed() {
     let mut rng = Lcg(5);
-    let texture: Vec<[f64; 2]> = (0..250)
-        .map(|_| [rng.next(), 4.0 * rng.next() - 2.0])
-        .collect();
-    let points: Vec<(u64, [f64; 3])> = (0..10u64)
-        .flat_map(|c| {
-            let x0 = c as f64 - 5.0;
-            texture
-                .iter()
-                .enumerate()
-                .map(move |(k, t)| (1000 * c + k as u64, [x0 + t[0], t[1], 5.0]))
-        })
-        .collect();
+    let points = facades(&mut rng, 10);
     let mut images: Vec<SparseImage> = (0..12)
         .map(|k| image(k + 1, -3.0 + 0.5 * k as f64, &points, 0.6, &mut rng))
         .collect();
