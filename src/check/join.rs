@@ -373,39 +373,32 @@ fn join_two(
             break;
         }
         let links = links(&pairs, &correspondences, &inliers);
-        let linked: usize = if degenerate(&correspondences, &inliers, tolerance) {
-            0
-        } else {
-            links.iter().map(|l| l.agreeing).sum()
+        let tested = Tested {
+            pair: [a, b],
+            evidence,
+            settings,
+            ghosts,
         };
-        if linked >= MIN_SUPPORT && ghosts.iter().any(|g| g.repeated_by(a, b, &placement)) {
-            // An earlier ghost's placement again: refuted then, whatever it scores now.
-            refuted += 1;
-        } else if linked >= MIN_SUPPORT {
-            let (merged, from_b) = put_together(a, b, &placement);
-            let counts =
-                conflict::count_model(&merged, Some(evidence), &settings.conflict, |name| {
-                    from_b.contains(name)
-                })?;
-            let score = score(&counts, settings);
-            // The check's own verdict on the two models put together.
-            if score >= settings.threshold && counts.conflicting >= settings.min_conflicts {
-                refuted += 1;
-            } else if let Some((_, at)) = &taken {
+        match (
+            tested.test(&placement, &links, &inliers, tolerance, &correspondences)?,
+            &taken,
+        ) {
+            (Test::Explains, _) => {}
+            (Test::Refuted, _) => refuted += 1,
+            (Test::Clean(..), Some((_, at))) => {
                 // A third place the check cannot refute, unless it is the taken one again.
                 if apart(b, &placement, at) > THIRD_PLACE_APART * spread {
                     return Ok(None);
                 }
-            } else if score >= accept_below {
-                // No ghost, so nothing weaker is taken after it, yet no better than a split the
-                // check would doubt: not taken either.
-                return Ok(None);
-            } else if refuted == 0 {
-                // The strongest clean placement joins the models only after a stronger one
-                // conflicted: without that, it may be a ghost the check cannot see (copies that
-                // share their surroundings), and nothing tells it from a true one.
-                return Ok(None);
-            } else {
+            }
+            // No ghost, so nothing weaker is taken after it, yet no better than a split the
+            // check would doubt: not taken either.
+            (Test::Clean(_, score), None) if score >= accept_below => return Ok(None),
+            // The strongest clean placement joins the models only after a stronger one
+            // conflicted: without that, it may be a ghost the check cannot see (copies that
+            // share their surroundings), and nothing tells it from a true one.
+            (Test::Clean(..), None) if refuted == 0 => return Ok(None),
+            (Test::Clean(counts, score), None) => {
                 let join = Join {
                     models,
                     correspondences: correspondences.len(),
@@ -429,6 +422,65 @@ fn join_two(
         remaining.retain(|k| !used.contains(k));
     }
     Ok(taken.map(|(join, _)| join))
+}
+
+/// What the check makes of one placement of [`join_two`].
+enum Test {
+    /// It explains too few correspondences' pairs to place anything ([`MIN_SUPPORT`]).
+    Explains,
+    /// It conflicts, or puts the models where an earlier run's ghost had them.
+    Refuted,
+    /// It does not conflict: the two models put together, their counts and score.
+    Clean(Counts, f64),
+}
+
+/// The models and evidence a placement of [`join_two`] is tested on.
+struct Tested<'a> {
+    pair: [&'a SparseModel; 2],
+    evidence: &'a Evidence,
+    settings: &'a CheckSettings,
+    ghosts: &'a [&'a Glued],
+}
+
+impl Tested<'_> {
+    /// `placement`, agreed with by `inliers` of correspondences `c` on `links`, tested.
+    fn test(
+        &self,
+        placement: &Similarity,
+        links: &[Link],
+        inliers: &[usize],
+        tolerance: f64,
+        c: &[Correspondence],
+    ) -> anyhow::Result<Test> {
+        let [a, b] = self.pair;
+        let linked: usize = if degenerate(c, inliers, tolerance) {
+            0
+        } else {
+            links.iter().map(|l| l.agreeing).sum()
+        };
+        if linked < MIN_SUPPORT {
+            return Ok(Test::Explains);
+        }
+        if self.ghosts.iter().any(|g| g.repeated_by(a, b, placement)) {
+            // An earlier ghost's placement again: refuted then, whatever it scores now.
+            return Ok(Test::Refuted);
+        }
+        let (merged, from_b) = put_together(a, b, placement);
+        let counts = conflict::count_model(
+            &merged,
+            Some(self.evidence),
+            &self.settings.conflict,
+            |name| from_b.contains(name),
+        )?;
+        let score = score(&counts, self.settings);
+        // The check's own verdict on the two models put together.
+        let conflicts =
+            score >= self.settings.threshold && counts.conflicting >= self.settings.min_conflicts;
+        Ok(match conflicts {
+            true => Test::Refuted,
+            false => Test::Clean(counts, score),
+        })
+    }
 }
 
 /// The database pairs between the two models' images (image of `a`, image of `b`) and every
