@@ -359,6 +359,14 @@ fn join_two(
     let tolerance = INLIER_DISTANCE * spread;
     let mut remaining: Vec<usize> = (0..correspondences.len()).collect();
     let mut rng = SplitMix(0);
+    let tested = Tested {
+        pair: [a, b],
+        evidence,
+        settings,
+        ghosts,
+        correspondences: &correspondences,
+        tolerance,
+    };
     let mut taken: Option<(Join, Similarity)> = None;
     // [`PLACEMENTS`] placements tried, and the one after a taken placement: its third place.
     for k in 0..=PLACEMENTS {
@@ -373,16 +381,8 @@ fn join_two(
             break;
         }
         let links = links(&pairs, &correspondences, &inliers);
-        let tested = Tested {
-            pair: [a, b],
-            evidence,
-            settings,
-            ghosts,
-        };
-        match (
-            tested.test(&placement, &links, &inliers, tolerance, &correspondences)?,
-            &taken,
-        ) {
+        let after_taken = taken.is_some();
+        match (tested.test(&placement, &links, &inliers)?, &taken) {
             (Test::Explains, _) => {}
             (Test::Refuted, _) => refuted += 1,
             (Test::Clean(..), Some((_, at))) => {
@@ -410,12 +410,9 @@ fn join_two(
                     links,
                 };
                 taken = Some((join, placement));
-                let used: BTreeSet<usize> = inliers.into_iter().collect();
-                remaining.retain(|k| !used.contains(k));
-                continue;
             }
         }
-        if taken.is_some() {
+        if after_taken {
             break;
         }
         let used: BTreeSet<usize> = inliers.into_iter().collect();
@@ -434,26 +431,27 @@ enum Test {
     Clean(Counts, f64),
 }
 
-/// The models and evidence a placement of [`join_two`] is tested on.
+/// The models, evidence and correspondences the placements of [`join_two`] are tested on.
 struct Tested<'a> {
     pair: [&'a SparseModel; 2],
     evidence: &'a Evidence,
     settings: &'a CheckSettings,
     ghosts: &'a [&'a Glued],
+    correspondences: &'a [Correspondence],
+    /// The agreement distance of the placements ([`INLIER_DISTANCE`] of the first's spread).
+    tolerance: f64,
 }
 
 impl Tested<'_> {
-    /// `placement`, agreed with by `inliers` of correspondences `c` on `links`, tested.
+    /// `placement`, agreed with by the correspondences `inliers` on `links`, tested.
     fn test(
         &self,
         placement: &Similarity,
         links: &[Link],
         inliers: &[usize],
-        tolerance: f64,
-        c: &[Correspondence],
     ) -> anyhow::Result<Test> {
         let [a, b] = self.pair;
-        let linked: usize = if degenerate(c, inliers, tolerance) {
+        let linked: usize = if degenerate(self.correspondences, inliers, self.tolerance) {
             0
         } else {
             links.iter().map(|l| l.agreeing).sum()
