@@ -8,7 +8,8 @@
 # own (docs/check.md, "Pieces that start no model"). Pieces of 3 images or more are kept
 # (`--Mapper.min_model_size 3`): COLMAP drops a model of fewer than 10, and a street's left-out
 # images can map as pieces of 4 to 9 each, every one dropped, leaving no model at all (docs/
-# check.md, "Pieces smaller than ten images"). COLMAP 4 needs none of this: its incremental
+# check.md, "Pieces smaller than ten images"); a caller's own `--Mapper.min_model_size` replaces
+# that 3 (COLMAP refuses an option given twice). COLMAP 4 needs none of this: its incremental
 # mapper relaxes while images are left, its global mapper has no initial pair.
 #
 # usage: scripts/map-left-out.sh DB IMAGES SPARSE [MAPPER_OPTION ...]
@@ -21,7 +22,7 @@
 # Prints how many images it gave the mapper. Environment: VGSEL, the vgsel-colmap binary
 # [vgsel-colmap on PATH].
 set -euo pipefail
-[ $# -ge 3 ] || { sed -n '14,22p' "$0" >&2; exit 2; }
+[ $# -ge 3 ] || { sed -n '15,23p' "$0" >&2; exit 2; }
 db=$1 images=$2 sparse=$3
 shift 3
 bin=${VGSEL:-vgsel-colmap}
@@ -39,10 +40,14 @@ if [ ! -s "$list" ]; then
   exit 0
 fi
 mkdir -p "$sparse/left"
+min_size=(--Mapper.min_model_size 3)
+for option in "$@"; do
+  [[ $option == --Mapper.min_model_size* ]] && min_size=()
+done
 # COLMAP 3.8 exits 1 where the images start no model (one image alone, or no initial pair even
 # relaxed): the run then stays as it was.
 if ! colmap mapper --database_path "$db" --image_path "$images" --output_path "$sparse/left" \
-  --image_list_path "$list" --Mapper.min_model_size 3 "$@" >"$sparse.left.log" 2>&1 &&
+  --image_list_path "$list" "${min_size[@]}" "$@" >"$sparse.left.log" 2>&1 &&
   ! grep -q "failed to create sparse model" "$sparse.left.log"; then
   tail -n 20 "$sparse.left.log" >&2
   echo "map-left-out: colmap mapper failed (log: $sparse.left.log)" >&2
