@@ -109,6 +109,55 @@ pub struct Join {
     pub links: Vec<Link>,
 }
 
+/// Two clean models [`join_models`] tried and left apart, and why: a user who sees a scene
+/// in pieces learns whether its matches could place them at all.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Apart {
+    /// The two models, as indices of the checked folders.
+    pub models: [usize; 2],
+    /// Correspondences between the two models.
+    pub correspondences: usize,
+    /// Placements the check refuted, earlier runs' ghosts between the two included.
+    pub refuted: usize,
+    /// Why no placement joins them.
+    pub reason: ApartReason,
+    /// The score of the placement the reason is about ([`ApartReason::Doubtful`],
+    /// [`ApartReason::NothingRefuted`], [`ApartReason::ThirdPlace`]: the one that would join).
+    pub score: Option<f64>,
+}
+
+/// Why [`join_models`] joins two models by none of their placements.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ApartReason {
+    /// No placement explains [`MIN_SUPPORT`] correspondences without a conflict: too few
+    /// matches between them, or every placement they give conflicted.
+    NoPlacement,
+    /// The strongest placement does not conflict, but none stronger was refuted: it may be a
+    /// ghost the check cannot see.
+    NothingRefuted,
+    /// The first placement without a conflict scores at or above the threshold under which
+    /// the repair keeps its links.
+    Doubtful,
+    /// Their matches place the second model in a third place as well ([`THIRD_PLACE_APART`]).
+    ThirdPlace,
+}
+
+/// What [`join_models`] made of each pair of clean models it tried.
+#[derive(Debug, Default)]
+pub struct Joins {
+    /// The pairs joined.
+    pub joined: Vec<Join>,
+    /// The pairs left apart.
+    pub apart: Vec<Apart>,
+}
+
+/// What [`join_two`] made of two models.
+enum Outcome {
+    Joined(Join),
+    Apart(Apart),
+}
+
 /// A similarity as the report writes it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Placement {
@@ -220,16 +269,17 @@ fn camera_points(cameras: &[ModelImage]) -> Vec<Vector3<f64>> {
 /// One correspondence: the second model's point, the first's, and the database pair it is from.
 type Correspondence = (Vector3<f64>, Vector3<f64>, usize);
 
-/// The joins among `models` (each with its check's verdict: ghosted models are not joined).
-/// Each pair of clean models with at least `min_group` images each is tried; the `earlier`
-/// runs' ghosts that put the two onto each other count as refuted placements.
+/// The joins among `models` (each with its check's verdict: ghosted models are not joined),
+/// and the pairs left apart. Each pair of clean models with at least `min_group` images each
+/// is tried; the `earlier` runs' ghosts that put the two onto each other count as refuted
+/// placements.
 pub fn join_models(
     models: &[(&SparseModel, bool)],
     evidence: &Evidence,
     settings: &CheckSettings,
     earlier: &[Glued],
-) -> anyhow::Result<Vec<Join>> {
-    let mut joins = Vec::new();
+) -> anyhow::Result<Joins> {
+    let mut joins = Joins::default();
     let below = kept_below(settings);
     let usable = |m: &(&SparseModel, bool)| !m.1 && m.0.images.len() >= settings.min_group;
     for a in 0..models.len() {
@@ -239,15 +289,10 @@ pub fn join_models(
                 let ghosts: Vec<&Glued> = (earlier.iter())
                     .filter(|g| g.between(pair[0], pair[1]))
                     .collect();
-                joins.extend(join_two(
-                    [a, b],
-                    pair,
-                    evidence,
-                    settings,
-                    0,
-                    &ghosts,
-                    below,
-                )?);
+                match join_two([a, b], pair, evidence, settings, 0, &ghosts, below)? {
+                    Outcome::Joined(join) => joins.joined.push(join),
+                    Outcome::Apart(apart) => joins.apart.push(apart),
+                }
             }
         }
     }
@@ -287,7 +332,9 @@ pub fn place_group(
     } else {
         settings.threshold
     };
-    let Some(join) = join_two([k, k], [&a, &b], evidence, settings, refuted, &[], below)? else {
+    let Outcome::Joined(join) =
+        join_two([k, k], [&a, &b], evidence, settings, refuted, &[], below)?
+    else {
         return Ok(None);
     };
     let placement = Similarity::from(&join.placement);
@@ -332,9 +379,9 @@ pub(super) fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
 
 /// The join of models `[a, b]` (their indices `models`): the first placement of `b` in `a`'s
 /// frame that does not conflict, if a stronger one did and the next one could not be taken
-/// too; `refuted` counts placements refuted before any is tried (a ghost's own), and each of
-/// the earlier runs' `ghosts` between the two refuted one more, and refutes its own placement
-/// again.
+/// too, else why they stay [`Apart`]; `refuted` counts placements refuted before any is tried
+/// (a ghost's own), and each of the earlier runs' `ghosts` between the two refuted one more,
+/// and refutes its own placement again.
 ///
 /// The next placement (of the correspondences the taken one leaves) can be a third place, as
 /// a misplaced image's ([`super::resection::THIRD_PLACE_SHARE`]): where it explains pairs,
@@ -352,7 +399,7 @@ fn join_two(
     refuted: usize,
     ghosts: &[&Glued],
     accept_below: f64,
-) -> anyhow::Result<Option<Join>> {
+) -> anyhow::Result<Outcome> {
     let mut refuted = refuted + ghosts.len();
     let (pairs, correspondences) = correspondences(a, b, evidence);
     let spread = spread(a);
@@ -360,6 +407,7 @@ fn join_two(
     let mut remaining: Vec<usize> = (0..correspondences.len()).collect();
     let mut rng = SplitMix(0);
     let tested = Tested {
+        models,
         pair: [a, b],
         evidence,
         settings,
@@ -382,35 +430,27 @@ fn join_two(
         }
         let links = links(&pairs, &correspondences, &inliers);
         let after_taken = taken.is_some();
-        match (tested.test(&placement, &links, &inliers)?, &taken) {
+        match (tested.test(&placement, links, &inliers)?, &taken) {
             (Test::Explains, _) => {}
             (Test::Refuted, _) => refuted += 1,
-            (Test::Clean(..), Some((_, at))) => {
+            (Test::Clean(_), Some((join, at))) => {
                 // A third place the check cannot refute, unless it is the taken one again.
                 if apart(b, &placement, at) > THIRD_PLACE_APART * spread {
-                    return Ok(None);
+                    return Ok(tested.apart(ApartReason::ThirdPlace, refuted, Some(join.score)));
                 }
             }
             // No ghost, so nothing weaker is taken after it, yet no better than a split the
             // check would doubt: not taken either.
-            (Test::Clean(_, score), None) if score >= accept_below => return Ok(None),
+            (Test::Clean(j), None) if j.score >= accept_below => {
+                return Ok(tested.apart(ApartReason::Doubtful, refuted, Some(j.score)));
+            }
             // The strongest clean placement joins the models only after a stronger one
             // conflicted: without that, it may be a ghost the check cannot see (copies that
             // share their surroundings), and nothing tells it from a true one.
-            (Test::Clean(..), None) if refuted == 0 => return Ok(None),
-            (Test::Clean(counts, score), None) => {
-                let join = Join {
-                    models,
-                    correspondences: correspondences.len(),
-                    placement: Placement::from(&placement),
-                    support: inliers.len(),
-                    refuted,
-                    counts,
-                    score,
-                    links,
-                };
-                taken = Some((join, placement));
+            (Test::Clean(j), None) if refuted == 0 => {
+                return Ok(tested.apart(ApartReason::NothingRefuted, refuted, Some(j.score)));
             }
+            (Test::Clean(join), None) => taken = Some((Join { refuted, ..*join }, placement)),
         }
         if after_taken {
             break;
@@ -418,7 +458,10 @@ fn join_two(
         let used: BTreeSet<usize> = inliers.into_iter().collect();
         remaining.retain(|k| !used.contains(k));
     }
-    Ok(taken.map(|(join, _)| join))
+    match taken {
+        Some((join, _)) => Ok(Outcome::Joined(join)),
+        None => Ok(tested.apart(ApartReason::NoPlacement, refuted, None)),
+    }
 }
 
 /// What the check makes of one placement of [`join_two`].
@@ -427,12 +470,14 @@ enum Test {
     Explains,
     /// It conflicts, or puts the models where an earlier run's ghost had them.
     Refuted,
-    /// It does not conflict: the two models put together, their counts and score.
-    Clean(Counts, f64),
+    /// It does not conflict: the join it makes (its `refuted` still to be counted).
+    Clean(Box<Join>),
 }
 
 /// The models, evidence and correspondences the placements of [`join_two`] are tested on.
 struct Tested<'a> {
+    /// The two models' indices, as [`Join::models`].
+    models: [usize; 2],
     pair: [&'a SparseModel; 2],
     evidence: &'a Evidence,
     settings: &'a CheckSettings,
@@ -443,11 +488,22 @@ struct Tested<'a> {
 }
 
 impl Tested<'_> {
+    /// The two models left apart, for `reason`.
+    fn apart(&self, reason: ApartReason, refuted: usize, score: Option<f64>) -> Outcome {
+        Outcome::Apart(Apart {
+            models: self.models,
+            correspondences: self.correspondences.len(),
+            refuted,
+            reason,
+            score,
+        })
+    }
+
     /// `placement`, agreed with by the correspondences `inliers` on `links`, tested.
     fn test(
         &self,
         placement: &Similarity,
-        links: &[Link],
+        links: Vec<Link>,
         inliers: &[usize],
     ) -> anyhow::Result<Test> {
         let [a, b] = self.pair;
@@ -476,7 +532,16 @@ impl Tested<'_> {
             score >= self.settings.threshold && counts.conflicting >= self.settings.min_conflicts;
         Ok(match conflicts {
             true => Test::Refuted,
-            false => Test::Clean(counts, score),
+            false => Test::Clean(Box::new(Join {
+                models: self.models,
+                correspondences: self.correspondences.len(),
+                placement: Placement::from(placement),
+                support: inliers.len(),
+                refuted: 0,
+                counts,
+                score,
+                links,
+            })),
         })
     }
 }

@@ -676,8 +676,9 @@ fn describe(
 pub struct RunCheck<'e> {
     /// Each model's check, in the order given.
     pub models: Vec<ModelCheck<'e>>,
-    /// The clean models the database's matches place in one frame ([`join`]).
-    pub joins: Vec<join::Join>,
+    /// The clean models the database's matches place in one frame ([`join`]), and those they
+    /// do not.
+    pub joins: join::Joins,
     /// The images no model registered that their matches place in a clean model.
     pub rejoined: Vec<resection::Rejoin>,
 }
@@ -735,7 +736,7 @@ pub fn check_run<'e>(
                 .collect();
             join::join_models(&checked, e, settings, earlier)?
         }
-        None => Vec::new(),
+        None => join::Joins::default(),
     };
     let rejoined = match evidence {
         Some(e) => rejoin(models, &checks, e)?,

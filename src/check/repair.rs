@@ -94,7 +94,13 @@ impl RunCheck<'_> {
             .models
             .iter()
             .flat_map(|c| c.misplaced.iter().chain(&c.ghost_placement));
-        for l in self.joins.iter().chain(placed).flat_map(|j| &j.links) {
+        for l in self
+            .joins
+            .joined
+            .iter()
+            .chain(placed)
+            .flat_map(|j| &j.links)
+        {
             links.insert(in_name_order(l.image1.clone(), l.image2.clone()));
         }
         let rejoin = (self.rejoined.iter())

@@ -2,6 +2,7 @@
 //! each seeing a random 60% of what is in view) and a ghosted one (two differently textured
 //! walls whose cameras were registered onto one place, joined by a shared object).
 
+use super::join::ApartReason;
 use super::repair::{blames, ModelEvidence};
 use super::resection::{DOMINANT_SUPPORT, THIRD_PLACE_SHARE};
 use super::*;
@@ -876,7 +877,18 @@ fn elsewhere() -> Similarity {
 #[test]
 fn two_models_are_not_joined_without_a_refuted_ghost() {
     let joins = joins_of_a_split(&correct_model(), |im| im.image.image_id > 6);
-    assert!(joins.is_empty(), "{joins:?}");
+    left_apart(&joins, ApartReason::NothingRefuted);
+}
+
+/// `joins` joined no models and left one pair apart, for `reason`.
+fn left_apart(joins: &join::Joins, reason: ApartReason) {
+    assert!(joins.joined.is_empty(), "{joins:?}");
+    assert_eq!(joins.apart.len(), 1, "{joins:?}");
+    let apart = &joins.apart[0];
+    assert_eq!((apart.models, apart.reason), ([0, 1], reason), "{apart:?}");
+    // A reason about a placement names its score; the one without a placement, none.
+    let about_one = reason != ApartReason::NoPlacement;
+    assert_eq!(apart.score.is_some(), about_one, "{apart:?}");
 }
 
 /// The same two models after a repair turn whose ghost had put them onto each other (an
@@ -902,8 +914,11 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     let strict = no_placement_taken();
     let passed_over =
         join::join_models(&pair, &evidence, &strict, std::slice::from_ref(&glued)).unwrap();
-    assert!(passed_over.is_empty(), "{passed_over:?}");
+    left_apart(&passed_over, ApartReason::Doubtful);
+    assert_eq!(passed_over.apart[0].refuted, 1);
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[glued]).unwrap();
+    assert!(joins.apart.is_empty(), "{joins:?}");
+    let joins = joins.joined;
     assert_eq!(joins.len(), 1, "{joins:?}");
     assert_eq!(joins[0].refuted, 1);
     assert!(!joins[0].links.is_empty());
@@ -919,7 +934,7 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     ];
     let across = join::Glued::new(&ghost, across);
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[across]).unwrap();
-    assert!(joins.is_empty(), "{joins:?}");
+    left_apart(&joins, ApartReason::NothingRefuted);
 }
 
 /// The same two models, where the earlier ghost had put them just as their matches place them
@@ -936,7 +951,9 @@ fn two_models_are_not_joined_where_an_earlier_ghost_had_them() {
     let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
     let pair = [(&a, false), (&b, false)];
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[glued]).unwrap();
-    assert!(joins.is_empty(), "{joins:?}");
+    left_apart(&joins, ApartReason::NoPlacement);
+    // The earlier ghost, and its placement proposed again.
+    assert_eq!(joins.apart[0].refuted, 2);
 }
 
 /// The ghosted model's two walls as two models: their matches (on the shared object) place
@@ -944,12 +961,13 @@ fn two_models_are_not_joined_where_an_earlier_ghost_had_them() {
 #[test]
 fn two_copies_matched_on_their_repeated_object_are_not_joined() {
     let joins = joins_of_a_split(&ghosted_model(), |im| im.image.image_id % 2 == 0);
-    assert!(joins.is_empty(), "{joins:?}");
+    left_apart(&joins, ApartReason::NoPlacement);
+    assert!(joins.apart[0].refuted >= 1, "{joins:?}");
 }
 
 /// The joins of `model` split into two models by `in_b`, the second in another frame, with the
 /// database matching every point the two see.
-fn joins_of_a_split(model: &SparseModel, in_b: impl Fn(&SparseImage) -> bool) -> Vec<join::Join> {
+fn joins_of_a_split(model: &SparseModel, in_b: impl Fn(&SparseImage) -> bool) -> join::Joins {
     let (a, b) = two_models(model, in_b, 100_000, &elsewhere());
     let evidence = matches_between(&a, &b, 100_000);
     join::join_models(
@@ -1005,12 +1023,11 @@ fn two_pieces_whose_matches_also_place_them_a_copy_on_are_not_joined() {
         )
         .unwrap()
     };
-    let joined = joins(false);
+    let joined = joins(false).joined;
     assert_eq!(joined.len(), 1, "{joined:?}");
     let (p, back) = (&joined[0].placement, back_from_elsewhere());
     assert!((p.scale - back.scale).abs() < 1e-6 * back.scale, "{p:?}");
-    let two_places = joins(true);
-    assert!(two_places.is_empty(), "{two_places:?}");
+    left_apart(&joins(true), ApartReason::ThirdPlace);
 }
 
 const HALL_OFFSET: u64 = 100_000;
@@ -1087,7 +1104,8 @@ fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_ref
         &DEFAULT_SETTINGS,
         &[],
     )
-    .unwrap();
+    .unwrap()
+    .joined;
     assert_eq!(joins.len(), 1, "{joins:?}");
     let join = &joins[0];
     assert_eq!(join.refuted, 1);
@@ -1353,7 +1371,7 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
     let evidence = |c: ModelCheck<'static>| {
         RunCheck {
             models: vec![c],
-            joins: Vec::new(),
+            joins: join::Joins::default(),
             rejoined: Vec::new(),
         }
         .evidence()
@@ -1424,7 +1442,7 @@ fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
         let wrong = model.wrong();
         let run = RunCheck {
             models: vec![model],
-            joins: Vec::new(),
+            joins: join::Joins::default(),
             rejoined: Vec::new(),
         };
         (wrong, run.evidence())

@@ -371,6 +371,51 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
     )
 }
 
+/// The line for two clean models left apart that share enough correspondences to be placed:
+/// why no placement joins them, so that a scene in pieces is not a mystery.
+fn apart_line(dirs: &[PathBuf], a: &check::join::Apart) -> String {
+    use check::join::ApartReason;
+    let score = a.score.unwrap_or(f64::NAN);
+    let why = match a.reason {
+        ApartReason::NoPlacement => format!(
+            "every placement their {} correspondences give conflicts or explains too few of \
+             their pairs; {} refuted",
+            a.correspondences, a.refuted
+        ),
+        ApartReason::NothingRefuted => format!(
+            "their strongest placement does not conflict, score {score:.2}, but nothing \
+             stronger was refuted: it may put copies onto each other"
+        ),
+        ApartReason::Doubtful => format!(
+            "their first placement without a conflict scores {score:.2}, too near a ghost's \
+             to keep its links"
+        ),
+        ApartReason::ThirdPlace => format!(
+            "their matches place the second in two places the check cannot tell apart, the \
+             first scoring {score:.2}"
+        ),
+    };
+    format!(
+        "{} + {}: apart ({why})",
+        dirs[a.models[0]].display(),
+        dirs[a.models[1]].display()
+    )
+}
+
+/// `item`'s JSON with the folders of its two `models` (indices of `dirs`) as `model_paths`.
+fn with_model_paths(
+    item: &impl serde::Serialize,
+    models: [usize; 2],
+    dirs: &[PathBuf],
+) -> Result<serde_json::Value> {
+    let mut value = serde_json::to_value(item)?;
+    value["model_paths"] = models
+        .map(|m| dirs[m].display().to_string())
+        .to_vec()
+        .into();
+    Ok(value)
+}
+
 /// What the check reads: the model folders, their models, the database's evidence (with the
 /// images no model registered read for placing them) and the images the database links that
 /// no model registered.
@@ -462,16 +507,17 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
     // Clean models of one run that the database's matches place in one frame without a
     // conflict: `prune --model` keeps the pairs that link them.
     let mut joined = Vec::new();
-    for join in &run.joins {
+    for join in &run.joins.joined {
         println!("{}", join_line(&dirs, join));
-        let mut value = serde_json::to_value(join)?;
-        value["model_paths"] = join
-            .models
-            .iter()
-            .map(|&m| dirs[m].display().to_string())
-            .collect::<Vec<_>>()
-            .into();
-        joined.push(value);
+        joined.push(with_model_paths(join, join.models, &dirs)?);
+    }
+    // Those left apart, with a line where their matches could have placed them.
+    let mut apart = Vec::new();
+    for pair in &run.joins.apart {
+        if pair.correspondences >= check::join::MIN_SUPPORT {
+            println!("{}", apart_line(&dirs, pair));
+        }
+        apart.push(with_model_paths(pair, pair.models, &dirs)?);
     }
     // What a repair turn would change: pairs that place a lost image and that the mapper
     // already had are no news (a turn would repeat the run), so the loop stops there.
@@ -496,6 +542,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
             "settings": settings,
             "models": reports,
             "joins": joined,
+            "apart": apart,
             "unregistered": unregistered,
             "rejoined": run.rejoined,
             "repair": repair,
@@ -652,6 +699,41 @@ mod tests {
         assert!(
             line.contains("groups of 3 and 1 images: 0010.png alone; 0 joining pairs"),
             "{line}"
+        );
+    }
+
+    /// Two models left apart are named with why, the score of the placement it is about
+    /// included, and the JSON beside the line names their folders.
+    #[test]
+    fn models_left_apart_say_why() {
+        use check::join::{Apart, ApartReason};
+        let dirs = [PathBuf::from("sparse/0"), PathBuf::from("sparse/1")];
+        let apart = |reason, score| Apart {
+            models: [0, 1],
+            correspondences: 400,
+            refuted: 1,
+            reason,
+            score,
+        };
+        let line = apart_line(&dirs, &apart(ApartReason::ThirdPlace, Some(0.12)));
+        assert!(line.starts_with("sparse/0 + sparse/1: apart (their matches place"));
+        assert!(line.contains("two places the check cannot tell apart, the first scoring 0.12"));
+        let line = apart_line(&dirs, &apart(ApartReason::NoPlacement, None));
+        assert!(
+            line.contains("their 400 correspondences give conflicts"),
+            "{line}"
+        );
+        assert!(line.ends_with("1 refuted)"), "{line}");
+        let line = apart_line(&dirs, &apart(ApartReason::Doubtful, Some(0.45)));
+        assert!(line.contains("scores 0.45, too near a ghost's"), "{line}");
+        let line = apart_line(&dirs, &apart(ApartReason::NothingRefuted, Some(0.02)));
+        assert!(line.contains("score 0.02, but nothing stronger"), "{line}");
+        let value = with_model_paths(&apart(ApartReason::ThirdPlace, Some(0.12)), [0, 1], &dirs);
+        let value = value.unwrap();
+        assert_eq!(value["reason"], "third_place");
+        assert_eq!(
+            value["model_paths"],
+            serde_json::json!(["sparse/0", "sparse/1"])
         );
     }
 }
