@@ -154,7 +154,9 @@ pub struct Joins {
 
 /// What [`join_two`] made of two models.
 enum Outcome {
+    /// Joined by the placement taken.
     Joined(Join),
+    /// Left apart, and why.
     Apart(Apart),
 }
 
