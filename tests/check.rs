@@ -396,8 +396,9 @@ fn colmap_mapper(db: &Path, images: &Path, out: &Path, list: Option<&Path>) -> O
 
 /// scripts/map-left-out.sh after a run that left out `left` of the images (the first ones by
 /// name): it prints how many it gave the mapper and lists them; with ten left out it maps
-/// them into SPARSE/left (with the caller's `--Mapper.min_model_size`), so that `check --unregistered` lists none; with one left out, which
-/// starts no model (COLMAP 3.8 exits 1 on that), it succeeds and leaves the run as it was.
+/// them into SPARSE/left (with the caller's `--Mapper.min_model_size`), so that `check
+/// --unregistered` lists none; with one left out, which starts no model (COLMAP 3.8 exits 1 on
+/// that), it succeeds and leaves the run as it was.
 fn left_out_images_are_mapped_on_their_own(work: &Path, images: &Path) {
     let mut names: Vec<String> = std::fs::read_dir(images)
         .unwrap()
