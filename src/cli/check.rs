@@ -375,7 +375,8 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
 /// why no placement joins them, so that a scene in pieces is not a mystery.
 fn apart_line(dirs: &[PathBuf], a: &check::join::Apart) -> String {
     use check::join::ApartReason;
-    let score = a.score.unwrap_or(f64::NAN);
+    // Every reason but `NoPlacement` has a scored placement; that one prints none.
+    let score = a.score.map_or_else(String::new, |s| format!("{s:.2}"));
     let why = match a.reason {
         ApartReason::NoPlacement => format!(
             "every placement their {} correspondences give conflicts or explains too few of \
@@ -383,16 +384,16 @@ fn apart_line(dirs: &[PathBuf], a: &check::join::Apart) -> String {
             a.correspondences, a.refuted
         ),
         ApartReason::NothingRefuted => format!(
-            "their strongest placement does not conflict, score {score:.2}, but nothing \
+            "their strongest placement does not conflict, score {score}, but nothing \
              stronger was refuted: it may put copies onto each other"
         ),
         ApartReason::Doubtful => format!(
-            "their first placement without a conflict scores {score:.2}, too near a ghost's \
+            "their first placement without a conflict scores {score}, too near a ghost's \
              to keep its links"
         ),
         ApartReason::ThirdPlace => format!(
             "their matches place the second in two places the check cannot tell apart, the \
-             first scoring {score:.2}"
+             first scoring {score}"
         ),
     };
     format!(
