@@ -283,8 +283,9 @@ fn the_repair_loop_from_the_twins_full_model_leaves_no_ghost() {
 /// 54 loops at hand that took the full model's evidence, both mappers): the turn's run,
 /// flagged (unanchored) or not, is the answer. It rests on the check seeing the full model's
 /// ghost: in 1 of 30 matchings at hand it did not (0.42: 1044 conflicting of 2009 judged, held
-/// down by the 500-sample prior), the loop took no turn and this failed. Left to fail there, as
-/// the loop does (docs/check.md, "The twin's global full model missed once").
+/// down by the 500-sample prior), the loop took no turn and this failed; since session 50 a
+/// split of groups is credited with 250 (0.46 there, flagged by a hair). Left to fail where the
+/// check misses, as the loop does (docs/check.md, "A smaller prior for splits of groups").
 /// About 15 s more.
 fn the_global_loop_never_answers_with_the_twins_hidden_ghost(dir: &Path) {
     let (work, pruned, answer, eval) = global_loop(dir);

@@ -528,7 +528,7 @@ impl Tested<'_> {
             &self.settings.conflict,
             |name| from_b.contains(name),
         )?;
-        let score = score(&counts, self.settings);
+        let score = score(&counts, false, self.settings);
         // The check's own verdict on the two models put together.
         let conflicts =
             score >= self.settings.threshold && counts.conflicting >= self.settings.min_conflicts;

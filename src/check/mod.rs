@@ -60,7 +60,8 @@ pub struct Split {
     pub counts: Counts,
     /// Conflict ratio: conflicting over judged samples.
     pub ratio: f64,
-    /// The score: conflicting over judged samples plus [`CheckSettings::prior`].
+    /// The score: conflicting over judged samples plus [`CheckSettings::prior`] (one image
+    /// alone: [`CheckSettings::alone_prior`]).
     pub score: f64,
     /// Pairs between the groups, most inliers first: the database's pairs a mapper could use,
     /// and the pairs that share 3D points in the model (only these without a database).
@@ -269,14 +270,14 @@ pub fn check_model<'e>(
     let (side, split) = match worst {
         Some((side, counts)) => {
             let mut split = describe(&views, &covisibility, &side, counts, pairs);
-            split.score = score(&counts, settings);
+            split.score = score(&counts, split.alone(), settings);
             (side, Some(split))
         }
         None => (vec![false; n], None),
     };
     let unanchored = unanchored(&views);
     let ghosted = match &split {
-        Some(s) if is_ghost(&s.counts, settings) => {
+        Some(s) if is_ghost(&s.counts, s.alone(), settings) => {
             !alone_placed_here(&views, s, evidence, &unanchored, settings)?
         }
         _ => false,
@@ -342,10 +343,17 @@ fn scored_worst(
     let mut worst = judged_split(scored, settings);
     // An image registered alone onto the other copy (a street's camera one building off) is no
     // split of groups; where no such split is ghosted, each image alone is scored too.
-    if n > 2 && !worst.as_ref().is_some_and(|w| is_ghost(&w.1, settings)) {
+    if n > 2
+        && !worst
+            .as_ref()
+            .is_some_and(|w| is_ghost(&w.1, alone(&w.0), settings))
+    {
         let (single, scored) = worst_alone(views, reach, &candidates, settings);
         splits_scored += scored;
-        if single.as_ref().is_some_and(|s| is_ghost(&s.1, settings)) {
+        if single
+            .as_ref()
+            .is_some_and(|s| is_ghost(&s.1, true, settings))
+        {
             worst = single;
         }
     }
@@ -420,7 +428,7 @@ fn weakest_link(
     (side != worst).then(|| {
         let counts = conflict::count(views, reach, &side, &settings.conflict);
         let mut split = describe(views, covisibility, &side, counts, pairs);
-        split.score = score(&counts, settings);
+        split.score = score(&counts, split.alone(), settings);
         (side, split)
     })
 }
@@ -484,7 +492,7 @@ fn refined_splits(
     settings: &CheckSettings,
 ) -> Vec<Vec<bool>> {
     let mut worst: Vec<&(Vec<bool>, Counts)> = scored.iter().collect();
-    worst.sort_by(|x, y| badness(&y.1, &x.1, settings));
+    worst.sort_by(|x, y| badness(y, x, settings));
     let mut out = Vec::new();
     for (side, _) in worst.into_iter().take(REFINED) {
         let side = splits::normalised(splits::refine(side, signed, settings.min_group));
@@ -496,16 +504,29 @@ fn refined_splits(
     out
 }
 
-/// The verdict on a split's counts: its score reaches the threshold, on enough conflicts.
-fn is_ghost(counts: &Counts, settings: &CheckSettings) -> bool {
-    score(counts, settings) >= settings.threshold && counts.conflicting >= settings.min_conflicts
+/// Whether a split (`side`, [`splits::normalised`] or not) is one image alone against the rest.
+fn alone(side: &[bool]) -> bool {
+    let first = side.iter().filter(|&&s| s).count();
+    first == 1 || first + 1 == side.len()
 }
 
-/// How split counts `a` compare with `b` in badness: enough conflicts to be judged first, then
+/// The verdict on a split's counts (`alone`: of one image against the rest): its score reaches
+/// the threshold, on enough conflicts.
+fn is_ghost(counts: &Counts, alone: bool, settings: &CheckSettings) -> bool {
+    score(counts, alone, settings) >= settings.threshold
+        && counts.conflicting >= settings.min_conflicts
+}
+
+/// How scored split `a` compares with `b` in badness: enough conflicts to be judged first, then
 /// the score.
-fn badness(a: &Counts, b: &Counts, settings: &CheckSettings) -> std::cmp::Ordering {
+fn badness(
+    a: &(Vec<bool>, Counts),
+    b: &(Vec<bool>, Counts),
+    settings: &CheckSettings,
+) -> std::cmp::Ordering {
     let judged = |c: &Counts| c.conflicting >= settings.min_conflicts;
-    (judged(a).cmp(&judged(b))).then(score(a, settings).total_cmp(&score(b, settings)))
+    let score = |(side, c): &(Vec<bool>, Counts)| score(c, alone(side), settings);
+    (judged(&a.1).cmp(&judged(&b.1))).then(score(a).total_cmp(&score(b)))
 }
 
 /// The worst of the `scored` splits: the highest score among those with enough conflicts to be
@@ -515,12 +536,12 @@ fn worst_split(
     settings: &CheckSettings,
 ) -> Option<(Vec<bool>, Counts)> {
     let mut worst: Option<(Vec<bool>, Counts)> = None;
-    for (side, counts) in scored {
+    for split in scored {
         if worst
             .as_ref()
-            .is_none_or(|w| badness(&counts, &w.1, settings).is_gt())
+            .is_none_or(|w| badness(&split, w, settings).is_gt())
         {
-            worst = Some((side, counts));
+            worst = Some(split);
         }
     }
     worst
@@ -540,7 +561,10 @@ fn judged_split(
 ) -> Option<(Vec<bool>, Counts)> {
     let net = |c: &Counts| c.conflicting as i64 - c.agreeing as i64;
     let mut ghost: Option<(Vec<bool>, Counts)> = None;
-    for (side, counts) in scored.iter().filter(|(_, c)| is_ghost(c, settings)) {
+    for (side, counts) in scored
+        .iter()
+        .filter(|(s, c)| is_ghost(c, alone(s), settings))
+    {
         if ghost.as_ref().is_none_or(|g| net(counts) > net(&g.1)) {
             ghost = Some((side.clone(), *counts));
         }
@@ -893,7 +917,11 @@ fn ghosted_without(
         .retain(|id, _| observers.get(id).is_some_and(|&n| n >= 2));
     let in_b = |name: &str| groups[1].iter().any(|n| n == name);
     let counts = conflict::count_model(&rest, Some(evidence), &settings.conflict, in_b)?;
-    Ok(is_ghost(&counts, settings))
+    Ok(is_ghost(
+        &counts,
+        groups.iter().any(|g| left(g) == 1),
+        settings,
+    ))
 }
 
 #[cfg(test)]

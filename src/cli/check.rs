@@ -82,9 +82,13 @@ pub struct CheckArgs {
     /// Expert: conflicting samples a ghosted split needs at least.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.min_conflicts)]
     min_conflicts: usize,
-    /// Expert: agreeing samples credited to every split (a ratio over few samples counts less).
+    /// Expert: agreeing samples credited to a split of groups (a ratio over few samples counts
+    /// less).
     #[arg(long, default_value_t = DEFAULT_SETTINGS.prior)]
     prior: usize,
+    /// Expert: agreeing samples credited to one image alone against the rest.
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.alone_prior)]
+    alone_prior: usize,
 }
 
 impl CheckArgs {
@@ -99,6 +103,7 @@ impl CheckArgs {
         s.min_group = self.min_group.max(1);
         s.min_conflicts = self.min_conflicts;
         s.prior = self.prior;
+        s.alone_prior = self.alone_prior;
         s.sequence = self.sequence;
         s
     }
