@@ -63,7 +63,16 @@ pub enum SceneKind {
     /// orbits linked by a short walk along the room's side; in capture order (first orbit,
     /// walk, second orbit). Views of the two objects from the same side match copy to copy.
     Hall,
+    /// Two identical objects side by side in one room ([`ADJACENT_GAP`] metres between their
+    /// centres), each half-orbited from the front, first one then the other: most views show
+    /// both, and the copies share the room behind them (the same walls, three boxes of their
+    /// own), as the lab photographs' cans and cereal boxes do; views of the two objects from
+    /// the same angle differ only in what stands beside and behind them.
+    Adjacent,
 }
+
+/// Distance in metres between the adjacent design's two objects (each 1.2 m wide).
+pub const ADJACENT_GAP: f64 = 3.0;
 
 /// Distance in metres from one building of the street to the next (3 m wide, 2 m gaps).
 pub const STREET_PERIOD: f64 = 5.0;
@@ -79,6 +88,7 @@ impl Named for SceneKind {
         SceneKind::Symmetric,
         SceneKind::Street,
         SceneKind::Hall,
+        SceneKind::Adjacent,
     ];
 
     fn name(self) -> &'static str {
@@ -89,6 +99,7 @@ impl Named for SceneKind {
             SceneKind::Symmetric => "symmetric",
             SceneKind::Street => "street",
             SceneKind::Hall => "hall",
+            SceneKind::Adjacent => "adjacent",
         }
     }
 
@@ -100,6 +111,7 @@ impl Named for SceneKind {
             SceneKind::Symmetric => "One object that looks the same from opposite sides, orbited all round",
             SceneKind::Street => "A row of identical buildings walked past by cameras translating along it",
             SceneKind::Hall => "Two identical objects in differently textured halves of a room, each orbited all round, linked by a walk",
+            SceneKind::Adjacent => "Two identical objects side by side in one room, each half-orbited from the front: the copies share their surroundings",
         }
     }
 }
@@ -458,6 +470,32 @@ fn hall(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
     (cuboids, poses)
 }
 
+/// [`SceneKind::Adjacent`]: its boxes and `num_images` cameras.
+fn adjacent(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let mut room = Cuboid::new([-7.0, -5.0, 0.0], [7.0, 5.0, 3.5], draws.tex());
+    room.inside = true;
+    let (a, b) = (-ADJACENT_GAP / 2.0, ADJACENT_GAP / 2.0);
+    let mut cuboids = vec![room];
+    cuboids.extend(draws.object(a, 0.0));
+    cuboids.extend(draws.object(b, 0.0));
+    // What only the room holds once: a box between the objects and behind them, one behind
+    // each side; each view of an object shows some of them, at places its copy's views do not.
+    for (min, max) in [
+        ([-0.3, 1.6, 0.0], [0.3, 2.2, 1.0]),
+        ([-4.2, 1.0, 0.0], [-3.4, 2.0, 1.4]),
+        ([3.0, 2.2, 0.0], [4.2, 2.8, 0.7]),
+    ] {
+        cuboids.push(Cuboid::new(min, max, draws.tex()));
+    }
+    // Half orbits on the front (-y) side, the same angles round each object, so that views of
+    // the two from one angle match copy to copy.
+    let per_orbit = num_images / 2;
+    let mut poses = Vec::new();
+    draws.orbit(&mut poses, a, per_orbit, 1.15 * PI, 0.7 * PI);
+    draws.orbit(&mut poses, b, num_images - per_orbit, 1.15 * PI, 0.7 * PI);
+    (cuboids, poses)
+}
+
 /// [`SceneKind::Street`]: its boxes and `num_images` cameras.
 fn street(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
     let length = STREET_PERIOD * STREET_BUILDINGS as f64;
@@ -536,6 +574,7 @@ impl Scene {
             SceneKind::Duplicate => duplicate(&mut draws, num_images),
             SceneKind::Street => street(&mut draws, num_images),
             SceneKind::Hall => hall(&mut draws, num_images),
+            SceneKind::Adjacent => adjacent(&mut draws, num_images),
         };
         Ok(Scene {
             cuboids,
@@ -836,6 +875,32 @@ mod tests {
         };
         assert!(round(&centres[..17], -5.0) && round(&centres[21..], 5.0));
         assert!(centres[17..21].iter().all(|c| (c.y + 3.2).abs() < 0.2));
+    }
+
+    /// The adjacent design's objects are identical and a gap apart in one room, and its two
+    /// half orbits go round the front of their own object at the same angles, in capture order.
+    #[test]
+    fn adjacent_half_orbits_see_identical_objects_side_by_side() {
+        let scene = Scene::build(SceneKind::Adjacent, 20, 1).unwrap();
+        let (room, a, b) = (&scene.cuboids[0], &scene.cuboids[1], &scene.cuboids[3]);
+        assert_eq!(a.faces, b.faces);
+        assert_eq!(room.faces, room.east);
+        assert_eq!(b.min - a.min, Vector3::new(ADJACENT_GAP, 0.0, 0.0));
+        let centres: Vec<_> = scene.truth.images.iter().map(|im| im.centre).collect();
+        for (k, c) in centres.iter().enumerate() {
+            let x = if k < 10 { -ADJACENT_GAP } else { ADJACENT_GAP } / 2.0;
+            assert!(
+                ((c.x - x).hypot(c.y) - 2.8).abs() < 0.3 && c.y < -0.5,
+                "{k}: {c}"
+            );
+        }
+        for k in 0..10 {
+            let step = centres[k + 10] - centres[k];
+            assert!(
+                (step - Vector3::x() * ADJACENT_GAP).norm() < 0.3,
+                "{k}: {step}"
+            );
+        }
     }
 
     /// The street's buildings are copies a period apart, and the cameras walk along the row.
