@@ -69,7 +69,14 @@ pub enum SceneKind {
     /// own), as the lab photographs' cans and cereal boxes do; views of the two objects from
     /// the same angle differ only in what stands beside and behind them.
     Adjacent,
+    /// The adjacent design in a plain room (walls and floor of one flat grey): only the objects
+    /// and the three boxes carry features, so the copies' surroundings hold little to tell them
+    /// apart, as in the lab photographs (cans and boxes before bare walls).
+    Plain,
 }
+
+/// The texture seed of a surface of one flat grey, on which SIFT finds nothing.
+const FLAT: u64 = u64::MAX;
 
 /// Distance in metres between the adjacent design's two objects (each 1.2 m wide).
 pub const ADJACENT_GAP: f64 = 3.0;
@@ -89,6 +96,7 @@ impl Named for SceneKind {
         SceneKind::Street,
         SceneKind::Hall,
         SceneKind::Adjacent,
+        SceneKind::Plain,
     ];
 
     fn name(self) -> &'static str {
@@ -100,6 +108,7 @@ impl Named for SceneKind {
             SceneKind::Street => "street",
             SceneKind::Hall => "hall",
             SceneKind::Adjacent => "adjacent",
+            SceneKind::Plain => "plain",
         }
     }
 
@@ -112,6 +121,7 @@ impl Named for SceneKind {
             SceneKind::Street => "A row of identical buildings walked past by cameras translating along it",
             SceneKind::Hall => "Two identical objects in differently textured halves of a room, each orbited all round, linked by a walk",
             SceneKind::Adjacent => "Two identical objects side by side in one room, each half-orbited from the front: the copies share their surroundings",
+            SceneKind::Plain => "The adjacent design in a room without texture: little but the objects to match, as in the lab photographs",
         }
     }
 }
@@ -198,6 +208,9 @@ fn value_noise(seed: u64, u: f64, v: f64) -> f64 {
 
 /// Grey level in [0, 1] of texture `seed` at face coordinates (u, v) in metres.
 fn texture(seed: u64, u: f64, v: f64) -> f64 {
+    if seed == FLAT {
+        return 0.5;
+    }
     let mut grey = 0.0;
     let mut weight = 0.5;
     for octave in 0..5 {
@@ -470,9 +483,12 @@ fn hall(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
     (cuboids, poses)
 }
 
-/// [`SceneKind::Adjacent`]: its boxes and `num_images` cameras.
-fn adjacent(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
-    let mut room = Cuboid::new([-7.0, -5.0, 0.0], [7.0, 5.0, 3.5], draws.tex());
+/// [`SceneKind::Adjacent`], or with a `plain` room [`SceneKind::Plain`]: its boxes and
+/// `num_images` cameras (the same textures and cameras either way).
+fn adjacent(draws: &mut Draws, num_images: usize, plain: bool) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    let walls = draws.tex();
+    let walls = if plain { [FLAT; 6] } else { walls };
+    let mut room = Cuboid::new([-7.0, -5.0, 0.0], [7.0, 5.0, 3.5], walls);
     room.inside = true;
     let (a, b) = (-ADJACENT_GAP / 2.0, ADJACENT_GAP / 2.0);
     let mut cuboids = vec![room];
@@ -574,7 +590,8 @@ impl Scene {
             SceneKind::Duplicate => duplicate(&mut draws, num_images),
             SceneKind::Street => street(&mut draws, num_images),
             SceneKind::Hall => hall(&mut draws, num_images),
-            SceneKind::Adjacent => adjacent(&mut draws, num_images),
+            SceneKind::Adjacent => adjacent(&mut draws, num_images, false),
+            SceneKind::Plain => adjacent(&mut draws, num_images, true),
         };
         Ok(Scene {
             cuboids,
@@ -901,6 +918,12 @@ mod tests {
                 "{k}: {step}"
             );
         }
+        // The plain design: the same cameras and boxes, the room one flat grey.
+        let plain = Scene::build(SceneKind::Plain, 20, 1).unwrap();
+        assert_eq!(plain.truth.images[7].centre, scene.truth.images[7].centre);
+        assert_eq!(plain.cuboids[0].faces, [FLAT; 6]);
+        assert_eq!(plain.cuboids.len(), scene.cuboids.len());
+        assert!((0..50).all(|k| texture(FLAT, k as f64 * 0.1, 0.3) == 0.5));
     }
 
     /// The street's buildings are copies a period apart, and the cameras walk along the row.
