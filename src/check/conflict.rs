@@ -26,6 +26,13 @@ pub struct ConflictSettings {
     pub radius: f64,
     /// Triangulated keypoints b needs in the neighbourhood for the sample to count.
     pub min_neighbours: usize,
+    /// What a bare sample weighs against a conflicting one (0: bare samples are not judged).
+    /// A bare sample is one where b has no keypoint at all near the projection: b sees a
+    /// surface without texture where A's textured structure is. Copies that share plain
+    /// surroundings conflict mostly so: the copy's structure, put where the other copy's
+    /// cameras see bare walls (the plain design's ghosts, docs/check.md). It weighs less than a
+    /// conflict, as a textureless occluder or a feature budget leaves a place bare too.
+    pub bare_weight: f64,
 }
 
 /// Counts of one split, both directions together.
@@ -42,16 +49,25 @@ pub struct Counts {
     /// Points both sides saw: the structure they share, not judged (for one image alone, see
     /// [`count_alone`]).
     pub seen: usize,
+    /// Samples whose neighbourhood holds no keypoint at all (counted only with a
+    /// [`ConflictSettings::bare_weight`]).
+    pub bare: usize,
 }
 
 impl Counts {
-    /// Conflicting samples over all that were judged; 0 without samples.
-    pub fn ratio(&self) -> f64 {
-        let judged = self.conflicting + self.agreeing;
-        if judged == 0 {
+    /// The conflicting samples, each bare one counted `bare_weight`.
+    pub fn conflicts(&self, bare_weight: f64) -> f64 {
+        self.conflicting as f64 + bare_weight * self.bare as f64
+    }
+
+    /// [`Counts::conflicts`] over themselves and the agreeing samples; 0 without samples.
+    pub fn ratio(&self, bare_weight: f64) -> f64 {
+        let conflicts = self.conflicts(bare_weight);
+        let judged = conflicts + self.agreeing as f64;
+        if judged == 0.0 {
             0.0
         } else {
-            self.conflicting as f64 / judged as f64
+            conflicts / judged
         }
     }
 }
@@ -275,6 +291,8 @@ pub(super) enum Sample {
     Agreeing,
     /// Only the own group's, but the database matched it to the projecting image's.
     Matched,
+    /// No keypoint at all near the projection.
+    Bare,
 }
 
 impl Counts {
@@ -286,13 +304,14 @@ impl Counts {
                 self.agreeing += 1;
                 self.matched += 1;
             }
+            Some(Sample::Bare) => self.bare += 1,
             None => {}
         }
     }
 }
 
 /// How one sample ends: `None` when not judged (behind, outside, too oblique or far off in
-/// scale, nothing near). `from` are the projecting side's observations of point `k` (view,
+/// scale, nothing triangulated near; without a bare weight, nothing near at all). `from` are the projecting side's observations of point `k` (view,
 /// keypoint); `ours(j)` says whether point `j` belongs to the projecting side.
 pub(super) fn judge(
     views: &Views,
@@ -319,7 +338,10 @@ pub(super) fn judge(
         n += 1;
     }
     if n < settings.min_neighbours {
-        return None;
+        let bare = settings.bare_weight > 0.0
+            && !(views.views[b].keypoints.iter())
+                .any(|q| (q[0] - at[0]).hypot(q[1] - at[1]) <= radius);
+        return bare.then_some(Sample::Bare);
     }
     let matched = from.iter().any(|&(a, keypoint)| {
         let seen = views.views[a].keypoints[keypoint as usize];

@@ -30,7 +30,7 @@
 
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
-use super::settings::{score, CheckSettings};
+use super::settings::{enough_conflicts, score, CheckSettings};
 use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
 use crate::geometry::similarity::Similarity;
@@ -531,7 +531,7 @@ impl Tested<'_> {
         let score = score(&counts, false, self.settings);
         // The check's own verdict on the two models put together.
         let conflicts =
-            score >= self.settings.threshold && counts.conflicting >= self.settings.min_conflicts;
+            score >= self.settings.threshold && enough_conflicts(&counts, self.settings);
         Ok(match conflicts {
             true => Test::Refuted,
             false => Test::Clean(Box::new(Join {

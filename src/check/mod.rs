@@ -28,7 +28,7 @@ use conflict::Counts;
 use evidence::{registered, Evidence};
 use rayon::prelude::*;
 use serde::Serialize;
-use settings::score;
+use settings::{enough_conflicts, score};
 pub use settings::{CheckSettings, DEFAULT_SETTINGS};
 use std::collections::BTreeMap;
 use views::Views;
@@ -269,8 +269,7 @@ pub fn check_model<'e>(
     let (worst, splits_scored) = scored_worst(&views, &covisibility, &reach, settings);
     let (side, split) = match worst {
         Some((side, counts)) => {
-            let mut split = describe(&views, &covisibility, &side, counts, pairs);
-            split.score = score(&counts, split.alone(), settings);
+            let split = describe(&views, &covisibility, &side, counts, pairs, settings);
             (side, Some(split))
         }
         None => (vec![false; n], None),
@@ -427,8 +426,7 @@ fn weakest_link(
     let side = splits::weakest_link_split(n, &covisibility.links(), settings.min_group)?;
     (side != worst).then(|| {
         let counts = conflict::count(views, reach, &side, &settings.conflict);
-        let mut split = describe(views, covisibility, &side, counts, pairs);
-        split.score = score(&counts, split.alone(), settings);
+        let split = describe(views, covisibility, &side, counts, pairs, settings);
         (side, split)
     })
 }
@@ -513,8 +511,7 @@ fn alone(side: &[bool]) -> bool {
 /// The verdict on a split's counts (`alone`: of one image against the rest): its score reaches
 /// the threshold, on enough conflicts.
 fn is_ghost(counts: &Counts, alone: bool, settings: &CheckSettings) -> bool {
-    score(counts, alone, settings) >= settings.threshold
-        && counts.conflicting >= settings.min_conflicts
+    score(counts, alone, settings) >= settings.threshold && enough_conflicts(counts, settings)
 }
 
 /// How scored split `a` compares with `b` in badness: enough conflicts to be judged first, then
@@ -524,7 +521,7 @@ fn badness(
     b: &(Vec<bool>, Counts),
     settings: &CheckSettings,
 ) -> std::cmp::Ordering {
-    let judged = |c: &Counts| c.conflicting >= settings.min_conflicts;
+    let judged = |c: &Counts| enough_conflicts(c, settings);
     let score = |(side, c): &(Vec<bool>, Counts)| score(c, alone(side), settings);
     (judged(&a.1).cmp(&judged(&b.1))).then(score(a).total_cmp(&score(b)))
 }
@@ -559,7 +556,8 @@ fn judged_split(
     scored: Vec<(Vec<bool>, Counts)>,
     settings: &CheckSettings,
 ) -> Option<(Vec<bool>, Counts)> {
-    let net = |c: &Counts| c.conflicting as i64 - c.agreeing as i64;
+    let bare_weight = settings.conflict.bare_weight;
+    let net = |c: &Counts| c.conflicts(bare_weight) - c.agreeing as f64;
     let mut ghost: Option<(Vec<bool>, Counts)> = None;
     for (side, counts) in scored
         .iter()
@@ -591,6 +589,7 @@ fn candidates(
     settings: &CheckSettings,
 ) -> (splits::SplitList, Vec<(f64, usize, usize)>) {
     let n = views.views.len();
+    let bare_weight = settings.conflict.bare_weight;
     let links = covisibility.links();
     let pairs: Vec<Counts> = links
         .par_iter()
@@ -599,21 +598,21 @@ fn candidates(
     let consistent: Vec<(f64, usize, usize)> = links
         .iter()
         .zip(&pairs)
-        .map(|(&(w, a, b), c)| (w * (1.0 - c.ratio()).powi(2), a, b))
+        .map(|(&(w, a, b), c)| (w * (1.0 - c.ratio(bare_weight)).powi(2), a, b))
         .collect();
     // With only the links that agree, two copies fall apart.
     let agreeing: Vec<(f64, usize, usize)> = links
         .iter()
         .zip(&pairs)
         .filter(|(_, c)| {
-            c.conflicting + c.agreeing >= PAIR_MIN_JUDGED && c.ratio() <= PAIR_MAX_RATIO
+            c.conflicting + c.agreeing >= PAIR_MIN_JUDGED && c.ratio(bare_weight) <= PAIR_MAX_RATIO
         })
         .map(|(l, _)| *l)
         .collect();
     // Each link's conflicting samples less its agreeing ones: what the best splits are refined
     // by (`splits::refine`).
     let signed = (links.iter().zip(&pairs))
-        .map(|(&(_, a, b), c)| (c.conflicting as f64 - c.agreeing as f64, a, b))
+        .map(|(&(_, a, b), c)| (c.conflicts(bare_weight) - c.agreeing as f64, a, b))
         .collect();
     let min = settings.min_group;
     let spectral = splits::spectral_splits(n, &agreeing, min);
@@ -638,6 +637,7 @@ fn describe(
     side: &[bool],
     counts: Counts,
     pairs: Option<&BTreeMap<(String, String), usize>>,
+    settings: &CheckSettings,
 ) -> Split {
     let names = |s: bool| -> Vec<String> {
         let mut g: Vec<String> = (0..side.len())
@@ -688,9 +688,8 @@ fn describe(
     Split {
         groups: [names(false), names(true)],
         counts,
-        ratio: counts.ratio(),
-        // Set by the caller, which knows the prior.
-        score: 0.0,
+        ratio: counts.ratio(settings.conflict.bare_weight),
+        score: score(&counts, alone(side), settings),
         joining_pairs: joining,
     }
 }

@@ -40,6 +40,7 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
         max_scale: 1.25,
         radius: 0.02,
         min_neighbours: 1,
+        bare_weight: 0.0,
     },
     min_group: 3,
     // Midway between the most a split of groups in a correct model scored (0.44) and the least
@@ -69,5 +70,11 @@ pub fn score(c: &Counts, alone: bool, settings: &CheckSettings) -> f64 {
     } else {
         settings.prior
     };
-    c.conflicting as f64 / (c.conflicting + c.agreeing + prior).max(1) as f64
+    let conflicts = c.conflicts(settings.conflict.bare_weight);
+    conflicts / (conflicts + (c.agreeing + prior) as f64).max(1.0)
+}
+
+/// Whether a split's counts hold enough conflicts to be judged (`--min_conflicts`).
+pub fn enough_conflicts(c: &Counts, settings: &CheckSettings) -> bool {
+    c.conflicts(settings.conflict.bare_weight) >= settings.min_conflicts as f64
 }

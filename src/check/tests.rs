@@ -1764,9 +1764,52 @@ fn counts(conflicting: usize, agreeing: usize) -> Counts {
     Counts {
         conflicting,
         agreeing,
-        matched: 0,
-        seen: 0,
+        ..Counts::default()
     }
+}
+
+/// Two images at one pose, each seeing its own half of a wall: each one's points project where
+/// the other has no keypoint at all. Bare samples, unjudged by default; with a bare weight they
+/// count, at that weight, as conflicts. An untriangulated keypoint next to a projection makes
+/// that sample neither bare nor judged.
+#[test]
+fn a_projection_onto_no_keypoint_at_all_is_bare() {
+    let mut rng = Lcg(11);
+    let points = wall(&mut rng, 400, 0);
+    let half = |left: bool| -> Vec<(u64, [f64; 3])> {
+        (points
+            .iter()
+            .filter(|(_, p)| (p[0] < -0.2) == left && p[0].abs() > 0.2))
+        .copied()
+        .collect()
+    };
+    let (left, right) = (half(true), half(false));
+    let images = vec![
+        image(1, 0.0, &left, 1.0, &mut rng),
+        image(2, 0.0, &right, 1.0, &mut rng),
+    ];
+    let mut with_keypoint = model(images.clone(), &points);
+    let views = Views::new(&with_keypoint, 0.02, None).unwrap();
+    let mut settings = DEFAULT_SETTINGS.conflict;
+    let unjudged = conflict::pair_counts(&views, 0, 1, &settings);
+    assert_eq!(unjudged, Counts::default());
+    settings.bare_weight = 0.5;
+    let counts = conflict::pair_counts(&views, 0, 1, &settings);
+    let seen = |v: usize| views.seen_by[v].len();
+    assert_eq!((counts.conflicting, counts.agreeing), (0, 0));
+    assert_eq!(counts.bare, seen(0) + seen(1), "{counts:?}");
+    assert_eq!(counts.conflicts(0.5), 0.5 * counts.bare as f64);
+    assert_eq!(counts.ratio(0.5), 1.0);
+    // One keypoint of image 2, on no point, where image 1's first point projects.
+    let first = views.seen_by[0][0];
+    let at = views.project(1, first).unwrap();
+    with_keypoint.images[1].points2d.push(Point2D {
+        xy: at,
+        point3d_id: None,
+    });
+    let views = Views::new(&with_keypoint, 0.02, None).unwrap();
+    let fewer = conflict::pair_counts(&views, 0, 1, &settings);
+    assert_eq!(fewer.bare + 1, counts.bare, "{fewer:?}");
 }
 
 #[test]
