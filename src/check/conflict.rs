@@ -311,8 +311,9 @@ impl Counts {
 }
 
 /// How one sample ends: `None` when not judged (behind, outside, too oblique or far off in
-/// scale, nothing triangulated near; without a bare weight, nothing near at all). `from` are the projecting side's observations of point `k` (view,
-/// keypoint); `ours(j)` says whether point `j` belongs to the projecting side.
+/// scale, nothing triangulated near; without a bare weight, nothing near at all). `from` are
+/// the projecting side's observations of point `k` (view, keypoint); `ours(j)` says whether
+/// point `j` belongs to the projecting side.
 pub(super) fn judge(
     views: &Views,
     k: usize,
@@ -338,9 +339,7 @@ pub(super) fn judge(
         n += 1;
     }
     if n < settings.min_neighbours {
-        let bare = settings.bare_weight > 0.0
-            && !(views.views[b].keypoints.iter())
-                .any(|q| (q[0] - at[0]).hypot(q[1] - at[1]) <= radius);
+        let bare = settings.bare_weight > 0.0 && !views.keypoint_near(b, at, radius);
         return bare.then_some(Sample::Bare);
     }
     let matched = from.iter().any(|&(a, keypoint)| {

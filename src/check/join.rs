@@ -30,7 +30,7 @@
 
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
-use super::settings::{enough_conflicts, score, CheckSettings};
+use super::settings::{is_ghost, score, CheckSettings};
 use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
 use crate::geometry::similarity::Similarity;
@@ -530,9 +530,7 @@ impl Tested<'_> {
         )?;
         let score = score(&counts, false, self.settings);
         // The check's own verdict on the two models put together.
-        let conflicts =
-            score >= self.settings.threshold && enough_conflicts(&counts, self.settings);
-        Ok(match conflicts {
+        Ok(match is_ghost(&counts, false, self.settings) {
             true => Test::Refuted,
             false => Test::Clean(Box::new(Join {
                 models: self.models,

@@ -28,7 +28,7 @@ use conflict::Counts;
 use evidence::{registered, Evidence};
 use rayon::prelude::*;
 use serde::Serialize;
-use settings::{enough_conflicts, score};
+use settings::{enough_conflicts, is_ghost, score};
 pub use settings::{CheckSettings, DEFAULT_SETTINGS};
 use std::collections::BTreeMap;
 use views::Views;
@@ -506,12 +506,6 @@ fn refined_splits(
 fn alone(side: &[bool]) -> bool {
     let first = side.iter().filter(|&&s| s).count();
     first == 1 || first + 1 == side.len()
-}
-
-/// The verdict on a split's counts (`alone`: of one image against the rest): its score reaches
-/// the threshold, on enough conflicts.
-fn is_ghost(counts: &Counts, alone: bool, settings: &CheckSettings) -> bool {
-    score(counts, alone, settings) >= settings.threshold && enough_conflicts(counts, settings)
 }
 
 /// How scored split `a` compares with `b` in badness: enough conflicts to be judged first, then

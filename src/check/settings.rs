@@ -74,6 +74,12 @@ pub fn score(c: &Counts, alone: bool, settings: &CheckSettings) -> f64 {
     conflicts / (conflicts + (c.agreeing + prior) as f64).max(1.0)
 }
 
+/// The verdict on a split's counts (`alone`: of one image against the rest): its score reaches
+/// the threshold, on enough conflicts.
+pub fn is_ghost(counts: &Counts, alone: bool, settings: &CheckSettings) -> bool {
+    score(counts, alone, settings) >= settings.threshold && enough_conflicts(counts, settings)
+}
+
 /// Whether a split's counts hold enough conflicts to be judged (`--min_conflicts`).
 pub fn enough_conflicts(c: &Counts, settings: &CheckSettings) -> bool {
     c.conflicts(settings.conflict.bare_weight) >= settings.min_conflicts as f64

@@ -328,6 +328,13 @@ impl<'e> Views<'e> {
             .map(|(_, k)| *k)
     }
 
+    /// Whether view `v` has any keypoint, on a point or not, within `radius` pixels of `at`.
+    /// A scan of all its keypoints (the grid holds only those on points): asked only with a
+    /// bare weight ([`super::conflict::ConflictSettings::bare_weight`]), off by default.
+    pub fn keypoint_near(&self, v: usize, at: [f64; 2], radius: f64) -> bool {
+        (self.views[v].keypoints.iter()).any(|q| (q[0] - at[0]).hypot(q[1] - at[1]) <= radius)
+    }
+
     /// Pixel position of point `k` in view `v`, if in front and inside the image.
     pub fn project(&self, v: usize, k: usize) -> Option<[f64; 2]> {
         let view = &self.views[v];

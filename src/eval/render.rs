@@ -486,6 +486,7 @@ fn hall(draws: &mut Draws, num_images: usize) -> (Vec<Cuboid>, Vec<CameraAim>) {
 /// [`SceneKind::Adjacent`], or with a `plain` room [`SceneKind::Plain`]: its boxes and
 /// `num_images` cameras (the same textures and cameras either way).
 fn adjacent(draws: &mut Draws, num_images: usize, plain: bool) -> (Vec<Cuboid>, Vec<CameraAim>) {
+    // Drawn either way, so that both designs get the same objects' and boxes' textures.
     let walls = draws.tex();
     let walls = if plain { [FLAT; 6] } else { walls };
     let mut room = Cuboid::new([-7.0, -5.0, 0.0], [7.0, 5.0, 3.5], walls);
