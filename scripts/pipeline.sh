@@ -16,6 +16,8 @@
 # environment (defaults in brackets):
 #   PRUNE_ARGS      extra `vgsel-colmap prune` options [none: prune's defaults; with REPAIR, the
 #                   loop's preset: --preset disambiguation]
+#   CHECK_ARGS      with REPAIR, `vgsel-colmap check` options for the loop's checks and its
+#                   `prune --model` runs alike, e.g. "--bare_weight 0.5" [none]
 #   MAX_IMAGE_SIZE  SIFT image size [1024]       MAX_FEATURES  SIFT features per image [2048]
 #   CAMERA_MODEL    [SIMPLE_RADIAL]              CAMERA_PARAMS known intrinsics, e.g. "f,cx,cy" []
 #   SINGLE_CAMERA   one camera for all images [1]
@@ -66,6 +68,8 @@ else
   # prune's own defaults, as a user's `vgsel-colmap prune` gets them.
   prune_args=${PRUNE_ARGS-}
 fi
+# The loop's check options, for its `check` runs and its `prune --model` alike.
+check_args=${CHECK_ARGS-}
 if [ -n "${VGSEL:-}" ]; then
   bin=$VGSEL
 elif [ -f "$here/Cargo.toml" ]; then
@@ -202,8 +206,9 @@ last=pruned models=() earlier=() answer= full_evidence=
 # its blame joins every turn's and the loop takes its first turn.
 if [ "${REPAIR:-0}" -gt 0 ] && made_model full; then
   status=0
+  # shellcheck disable=SC2086 # CHECK_ARGS is a list of options
   "$bin" check --model "$work/sparse_full" --database_path "$work/full.db" \
-    --report "$work/check_full.json" >"$work/check_full.txt" || status=$?
+    --report "$work/check_full.json" $check_args >"$work/check_full.txt" || status=$?
   cat "$work/check_full.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   if share=$("$here/scripts/repair_loop.py" full-model "$work/check_full.json" "$work/pruned.db"); then
@@ -223,8 +228,9 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
     break
   fi
   status=0
+  # shellcheck disable=SC2086
   "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" "${earlier[@]}" \
-    --report "$work/check_$last.json" >"$work/check_$last.txt" || status=$?
+    --report "$work/check_$last.json" $check_args >"$work/check_$last.txt" || status=$?
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   # A clean verdict answers, but the pruned run's where the full model's ghost came first:
@@ -239,7 +245,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   log "turn $turn: prune --model with the check's evidence (a ghost, a misplaced group or image, pieces or lost images)"
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
-    --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args
+    --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args $check_args
   if "$here/scripts/repair_loop.py" same-selection "$work/$last.db" "$work/repaired$turn.db"; then
     log "turn $turn selects what the $last run mapped: the loop stops"
     break

@@ -10,10 +10,10 @@ use super::evidence::Evidence;
 use super::views::Views;
 use crate::colmap::sparse::SparseModel;
 use nalgebra::Vector3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// How the conflicts are counted.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ConflictSettings {
     /// Largest angle, in degrees, between b's ray to the point and the ray of an image of A that
     /// saw it: beyond it, b might not see the point as A did (other side, occlusion, scale).

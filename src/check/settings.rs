@@ -1,10 +1,10 @@
 //! What the check's verdict depends on: its settings, their defaults, and a split's score.
 
 use super::conflict::{ConflictSettings, Counts};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Everything the check's verdict depends on.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CheckSettings {
     /// How conflicts are counted.
     pub conflict: ConflictSettings,
@@ -61,6 +61,12 @@ pub const DEFAULT_SETTINGS: CheckSettings = CheckSettings {
     alone_prior: 500,
     sequence: false,
 };
+
+impl Default for CheckSettings {
+    fn default() -> Self {
+        DEFAULT_SETTINGS
+    }
+}
 
 /// A split's score: conflicting over judged samples plus the prior, one image `alone`'s or a
 /// split of groups'.

@@ -5,6 +5,7 @@ use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Duration;
+use vgsel_colmap::check::{CheckSettings, DEFAULT_SETTINGS};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::flow::search::GivenCriteria;
 use vgsel_colmap::named::Named;
@@ -189,5 +190,71 @@ fn lock_seconds(s: &str) -> Result<f64, String> {
     match non_negative(s) {
         Ok(x) if x <= 604_800.0 => Ok(x),
         _ => Err(format!("`{s}` is not a number of seconds in [0, 604800]")),
+    }
+}
+
+/// The check's settings as options: `check`'s, and `prune --model`'s for the check it runs on
+/// each folder, so that the loop judges as the check a user ran (each needs `--model`).
+#[derive(Args, Clone)]
+#[command(rename_all = "snake_case")]
+pub struct CheckOptions {
+    /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.threshold, value_parser = fraction)]
+    threshold: f64,
+    /// Expert: score under which a placement whose links the repair keeps (a ghost's group
+    /// placed back, two clean models joined) is taken; from it up to --threshold, none is.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.placement_threshold, value_parser = fraction)]
+    placement_threshold: f64,
+    /// Expert: with the database, score from which one image alone is ghosted though its own
+    /// matches place it where the model does.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.alone_threshold, value_parser = fraction)]
+    alone_threshold: f64,
+    /// Expert: largest angle (degrees) between two images' rays for one to be expected to see
+    /// what the other saw.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
+    max_angle: f64,
+    /// Expert: largest ratio between two images' distances to a point for one to be expected to
+    /// see what the other saw there.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.max_scale)]
+    max_scale: f64,
+    /// Expert: neighbourhood radius around a projected point, as a fraction of the image diagonal.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.radius, value_parser = fraction)]
+    radius: f64,
+    /// Expert: what a sample weighs, against a conflicting one, where the image has no keypoint
+    /// at all near the projected point (a bare surface where the other group's structure is);
+    /// 0 leaves such samples unjudged. Measured, not yet the default (docs/check.md).
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.bare_weight, value_parser = fraction)]
+    bare_weight: f64,
+    /// Expert: images each group needs at least.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.min_group)]
+    min_group: usize,
+    /// Expert: conflicting samples a ghosted split needs at least.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.min_conflicts)]
+    min_conflicts: usize,
+    /// Expert: agreeing samples credited to a split of groups (a ratio over few samples counts
+    /// less).
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.prior)]
+    prior: usize,
+    /// Expert: agreeing samples credited to one image alone against the rest.
+    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.alone_prior)]
+    alone_prior: usize,
+}
+
+impl CheckOptions {
+    /// The settings these options give (never `sequence`: `check --sequence` sets it).
+    pub fn settings(&self) -> CheckSettings {
+        let mut s = DEFAULT_SETTINGS;
+        s.threshold = self.threshold;
+        s.placement_threshold = self.placement_threshold;
+        s.alone_threshold = self.alone_threshold;
+        s.conflict.max_angle_deg = self.max_angle;
+        s.conflict.max_scale = self.max_scale.max(1.0);
+        s.conflict.radius = self.radius;
+        s.conflict.bare_weight = self.bare_weight;
+        s.min_group = self.min_group.max(1);
+        s.min_conflicts = self.min_conflicts;
+        s.prior = self.prior;
+        s.alone_prior = self.alone_prior;
+        s
     }
 }

@@ -1,13 +1,14 @@
 //! `check`: is a reconstruction ghosted, and where? One line per model, a JSON report, a top
 //! view per model, and an exit status a pipeline can branch on (3: a model is wrong).
 
+use super::args::CheckOptions;
 use crate::cli::progress::Progress;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use vgsel_colmap::check::evidence::Evidence;
 use vgsel_colmap::check::resection::Rejoin;
-use vgsel_colmap::check::{self, CheckSettings, ModelCheck, Verdict, DEFAULT_SETTINGS};
+use vgsel_colmap::check::{self, CheckSettings, ModelCheck, Verdict};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
 use vgsel_colmap::colmap::sparse::{read_sparse_model, SparseModel};
@@ -54,64 +55,16 @@ pub struct CheckArgs {
     /// two surfaces is folded.
     #[arg(long, requires = "database_path")]
     sequence: bool,
-    /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = super::args::fraction)]
-    threshold: f64,
-    /// Expert: score under which a placement whose links the repair keeps (a ghost's group
-    /// placed back, two clean models joined) is taken; from it up to --threshold, none is.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.placement_threshold, value_parser = super::args::fraction)]
-    placement_threshold: f64,
-    /// Expert: with the database, score from which one image alone is ghosted though its own
-    /// matches place it where the model does.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.alone_threshold, value_parser = super::args::fraction)]
-    alone_threshold: f64,
-    /// Expert: largest angle (degrees) between two images' rays for one to be expected to see
-    /// what the other saw.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
-    max_angle: f64,
-    /// Expert: largest ratio between two images' distances to a point for one to be expected to
-    /// see what the other saw there.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_scale)]
-    max_scale: f64,
-    /// Expert: neighbourhood radius around a projected point, as a fraction of the image diagonal.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.radius, value_parser = super::args::fraction)]
-    radius: f64,
-    /// Expert: what a sample weighs, against a conflicting one, where the image has no keypoint
-    /// at all near the projected point (a bare surface where the other group's structure is);
-    /// 0 leaves such samples unjudged. Measured, not yet the default (docs/check.md).
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.bare_weight, value_parser = super::args::fraction)]
-    bare_weight: f64,
-    /// Expert: images each group needs at least.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.min_group)]
-    min_group: usize,
-    /// Expert: conflicting samples a ghosted split needs at least.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.min_conflicts)]
-    min_conflicts: usize,
-    /// Expert: agreeing samples credited to a split of groups (a ratio over few samples counts
-    /// less).
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.prior)]
-    prior: usize,
-    /// Expert: agreeing samples credited to one image alone against the rest.
-    #[arg(long, default_value_t = DEFAULT_SETTINGS.alone_prior)]
-    alone_prior: usize,
+    #[command(flatten)]
+    options: CheckOptions,
 }
 
 impl CheckArgs {
     fn settings(&self) -> CheckSettings {
-        let mut s = DEFAULT_SETTINGS;
-        s.threshold = self.threshold;
-        s.placement_threshold = self.placement_threshold;
-        s.alone_threshold = self.alone_threshold;
-        s.conflict.max_angle_deg = self.max_angle;
-        s.conflict.max_scale = self.max_scale.max(1.0);
-        s.conflict.radius = self.radius;
-        s.conflict.bare_weight = self.bare_weight;
-        s.min_group = self.min_group.max(1);
-        s.min_conflicts = self.min_conflicts;
-        s.prior = self.prior;
-        s.alone_prior = self.alone_prior;
-        s.sequence = self.sequence;
-        s
+        CheckSettings {
+            sequence: self.sequence,
+            ..self.options.settings()
+        }
     }
 }
 
@@ -578,7 +531,7 @@ pub fn run(args: &CheckArgs, quiet: bool, progress: &Progress) -> Result<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use check::{conflict::Counts, Split};
+    use check::{conflict::Counts, Split, DEFAULT_SETTINGS};
 
     fn checked(conflicting: usize, agreeing: usize) -> ModelCheck<'static> {
         let names = |n: usize| (0..n).map(|k| format!("{k}.png")).collect();

@@ -1,7 +1,7 @@
 //! `prune`: selects the pairs the mapper should use and invalidates the others in
 //! two_view_geometries, in place (reversible by `restore`) or in a copy.
 
-use super::args::{choice, fraction, weights, DatabaseArg, FlowArgs, Weights};
+use super::args::{choice, fraction, weights, CheckOptions, DatabaseArg, FlowArgs, Weights};
 use crate::cli::progress::Progress;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -21,6 +21,7 @@ const SELECT: &str = "What to select";
 const WRITE: &str = "Where to write";
 const REPORTS: &str = "Reports";
 const EXPERT: &str = "Expert: the flow search and the costs";
+const CHECK: &str = "Expert: the check of --model's folders (as `check`'s)";
 
 /// `prune`'s options, grouped as `--help` shows them: the everyday ones first.
 #[derive(Args)]
@@ -73,6 +74,9 @@ pub struct PruneArgs {
     /// A pair is a view-graph edge when it has at least this many verified inliers.
     #[arg(long, default_value_t = DEFAULT_MIN_NUM_MATCHES, help_heading = SELECT)]
     min_num_matches: usize,
+
+    #[command(flatten, next_help_heading = CHECK)]
+    check: CheckOptions,
 
     #[command(flatten, next_help_heading = WRITE)]
     database: DatabaseArg,
@@ -165,6 +169,7 @@ impl PruneArgs {
             forbid_pairs: self.forbid_pairs.clone(),
             forbid_images: self.forbid_images.clone(),
             model: self.model.clone(),
+            check: Some(self.check.settings()),
             ..self.flow.given()
         }
     }

@@ -23,6 +23,7 @@
 //! starting with `#` are skipped.
 
 use crate::check::resection::PairMatches;
+use crate::check::CheckSettings;
 use crate::colmap::database::Image;
 use crate::flow::network::ArcRule;
 use crate::flow::search::FlowRule;
@@ -49,6 +50,8 @@ pub struct ArcRules {
     /// (that glued a ghost, or that a wrong model refused) are never selected, and the pairs
     /// that link clean models are kept.
     pub model: Vec<PathBuf>,
+    /// How the check judges `model`'s folders (`prune`'s check options).
+    pub check: CheckSettings,
 }
 
 /// One list file as read: each entry with its 1-based line number.

@@ -67,6 +67,8 @@ pub struct Given {
     pub forbid_images: Option<PathBuf>,
     /// `--model`, each time it is given.
     pub model: Vec<PathBuf>,
+    /// The check's options for `--model`'s folders (its defaults where not given).
+    pub check: Option<check::CheckSettings>,
 }
 
 /// Everything that decides a selection, besides the database.
@@ -186,6 +188,7 @@ impl Parameters {
                 forbid_pairs: given.forbid_pairs,
                 forbid_images: given.forbid_images,
                 model: given.model,
+                check: given.check.unwrap_or_default(),
             },
         })
     }
@@ -218,7 +221,7 @@ impl Parameters {
                 .flat_map(|models| evidence.lost(models, self.min_num_matches))
                 .collect();
             evidence.read_lost(db, &lost)?;
-            let settings = &check::DEFAULT_SETTINGS;
+            let settings = &rules.check;
             let (found, _) =
                 check::repair::loop_evidence(&rules.model, &runs, "--model", &evidence, settings)?;
             for (dir, found) in rules.model.iter().zip(found) {
@@ -288,6 +291,9 @@ struct Recorded {
         deserialize_with = "one_or_more"
     )]
     model: Vec<String>,
+    /// The check's settings for `model`, where not the defaults.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    check: Option<check::CheckSettings>,
 }
 
 /// A recorded `model`: a list, or one string as recorded before `--model` could be repeated.
@@ -337,6 +343,7 @@ impl From<Parameters> for Recorded {
             model: (p.arc_rules.model.iter())
                 .map(|dir| dir.display().to_string())
                 .collect(),
+            check: (p.arc_rules.check != check::DEFAULT_SETTINGS).then_some(p.arc_rules.check),
         }
     }
 }
@@ -377,6 +384,7 @@ impl From<Recorded> for Parameters {
                 forbid_pairs: r.forbid_pairs.map(PathBuf::from),
                 forbid_images: r.forbid_images.map(PathBuf::from),
                 model: r.model.into_iter().map(PathBuf::from).collect(),
+                check: r.check.unwrap_or_default(),
             },
         }
     }
@@ -450,6 +458,31 @@ mod tests {
         let two: Parameters = serde_json::from_value(recorded.clone()).unwrap();
         assert_eq!(two.arc_rules.model.len(), 2);
         assert_eq!(serde_json::to_value(&two).unwrap(), recorded);
+    }
+
+    /// The check's settings for `--model` are recorded only where they are not the defaults
+    /// (a record without them, as every earlier one, is the defaults), and read back as given.
+    #[test]
+    fn the_check_settings_of_model_folders_are_recorded_where_given() {
+        let mut check = check::DEFAULT_SETTINGS;
+        let given = |check| Given {
+            model: vec![PathBuf::from("sparse")],
+            check,
+            ..Given::default()
+        };
+        let defaults = Parameters::resolve(given(Some(check))).unwrap();
+        let recorded = serde_json::to_value(&defaults).unwrap();
+        assert!(recorded.get("check").is_none(), "{recorded}");
+        assert_eq!(Parameters::resolve(given(None)).unwrap(), defaults);
+        check.conflict.bare_weight = 0.5;
+        let bare = Parameters::resolve(given(Some(check))).unwrap();
+        assert_eq!(bare.arc_rules.check, check);
+        let recorded = serde_json::to_value(&bare).unwrap();
+        assert_eq!(recorded["check"]["conflict"]["bare_weight"], 0.5);
+        assert_eq!(
+            serde_json::from_value::<Parameters>(recorded).unwrap(),
+            bare
+        );
     }
 
     /// A capture sequence leaves the disambiguation-global preset's cost to backbone_tracks,
