@@ -1812,6 +1812,39 @@ fn a_projection_onto_no_keypoint_at_all_is_bare() {
     assert_eq!(fewer.bare + 1, counts.bare, "{fewer:?}");
 }
 
+/// Whether an image has a keypoint near a place, from its keypoints in grid cells, is what a
+/// scan of every keypoint says: at random places, at radii up to the cell, keypoints
+/// triangulated or not, on cell edges and off the image.
+#[test]
+fn a_keypoint_near_is_found_by_its_cells_as_by_a_scan() {
+    let mut rng = Lcg(5);
+    let points = wall(&mut rng, 200, 0);
+    let mut m = model(vec![image(1, 0.0, &points, 0.5, &mut rng)], &points);
+    let views = Views::new(&m, 0.02, None).unwrap();
+    let cell = views.cell;
+    for k in 0..300 {
+        let xy = match k % 3 {
+            0 => [(k / 3) as f64 * cell, 2.0 * cell],
+            _ => [rng.next() * 700.0 - 50.0, rng.next() * 500.0 - 50.0],
+        };
+        m.images[0].points2d.push(Point2D {
+            xy,
+            point3d_id: None,
+        });
+    }
+    let views = Views::new(&m, 0.02, None).unwrap();
+    let keypoints = &views.views[0].keypoints;
+    let (mut near, mut far) = (0, 0);
+    for _ in 0..5000 {
+        let at = [rng.next() * 700.0 - 50.0, rng.next() * 500.0 - 50.0];
+        let radius = rng.next() * cell;
+        let scan = (keypoints.iter()).any(|q| (q[0] - at[0]).hypot(q[1] - at[1]) <= radius);
+        assert_eq!(views.keypoint_near(0, at, radius), scan, "{at:?} {radius}");
+        *if scan { &mut near } else { &mut far } += 1;
+    }
+    assert!(near > 500 && far > 500, "{near} near, {far} far");
+}
+
 #[test]
 fn the_splits_refined_are_the_worst_judged_first() {
     let settings = DEFAULT_SETTINGS;

@@ -9,6 +9,7 @@ use crate::colmap::sparse::SparseModel;
 use anyhow::{Context, Result};
 use nalgebra::{Matrix3, Vector3};
 use std::collections::{BTreeMap, HashMap};
+use std::sync::OnceLock;
 
 /// Intrinsics as a pinhole with up to two radial and two tangential coefficients (OpenCV's
 /// meaning, which is COLMAP's for the models it names alike).
@@ -116,6 +117,9 @@ pub struct View {
     pub keypoints: Vec<[f64; 2]>,
     /// The point each keypoint observes, by keypoint index (None: not triangulated).
     pub point_of: Vec<Option<usize>>,
+    /// Every keypoint's index in grid cells of [`Views::cell`] pixels, built the first time
+    /// [`Views::keypoint_near`] asks: only bare samples need it.
+    pub keypoint_cells: OnceLock<HashMap<(i64, i64), Vec<u32>>>,
 }
 
 /// The model as the check reads it, borrowing the database's matches from the [`Evidence`].
@@ -184,11 +188,9 @@ impl<'e> Views<'e> {
                 };
                 point_of[keypoint] = Some(*k);
                 tracks[*k].push((v, keypoint as u32));
-                let key = (
-                    (p.xy[0] / cell).floor() as i64,
-                    (p.xy[1] / cell).floor() as i64,
-                );
-                grid.entry(key).or_default().push((p.xy, *k));
+                grid.entry(cell_of(p.xy, cell))
+                    .or_default()
+                    .push((p.xy, *k));
             }
             let rotation = im.image.rotation.to_rotation_matrix().into_inner();
             views.push(View {
@@ -200,6 +202,7 @@ impl<'e> Views<'e> {
                 grid,
                 keypoints: im.points2d.iter().map(|p| p.xy).collect(),
                 point_of,
+                keypoint_cells: OnceLock::new(),
             });
         }
         let mut seen_by = vec![Vec::new(); views.len()];
@@ -315,24 +318,33 @@ impl<'e> Views<'e> {
         at: [f64; 2],
         radius: f64,
     ) -> impl Iterator<Item = usize> + '_ {
-        let (cx, cy) = (
-            (at[0] / self.cell).floor() as i64,
-            (at[1] / self.cell).floor() as i64,
-        );
         let grid = &self.views[v].grid;
-        (cx - 1..=cx + 1)
-            .flat_map(move |x| (cy - 1..=cy + 1).map(move |y| (x, y)))
+        around(cell_of(at, self.cell))
             .filter_map(move |key| grid.get(&key))
             .flatten()
             .filter(move |(xy, _)| (xy[0] - at[0]).hypot(xy[1] - at[1]) <= radius)
             .map(|(_, k)| *k)
     }
 
-    /// Whether view `v` has any keypoint, on a point or not, within `radius` pixels of `at`.
-    /// A scan of all its keypoints (the grid holds only those on points): asked only with a
-    /// bare weight ([`super::conflict::ConflictSettings::bare_weight`]), off by default.
+    /// Whether view `v` has any keypoint, on a point or not, within `radius` pixels of `at`
+    /// (at most [`Views::cell`]), from its [`View::keypoint_cells`].
     pub fn keypoint_near(&self, v: usize, at: [f64; 2], radius: f64) -> bool {
-        (self.views[v].keypoints.iter()).any(|q| (q[0] - at[0]).hypot(q[1] - at[1]) <= radius)
+        let view = &self.views[v];
+        let cells = view.keypoint_cells.get_or_init(|| {
+            let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
+            for (k, &xy) in view.keypoints.iter().enumerate() {
+                cells
+                    .entry(cell_of(xy, self.cell))
+                    .or_default()
+                    .push(k as u32);
+            }
+            cells
+        });
+        around(cell_of(at, self.cell))
+            .filter_map(|key| cells.get(&key))
+            .flatten()
+            .map(|&k| view.keypoints[k as usize])
+            .any(|q| (q[0] - at[0]).hypot(q[1] - at[1]) <= radius)
     }
 
     /// Pixel position of point `k` in view `v`, if in front and inside the image.
@@ -341,6 +353,16 @@ impl<'e> Views<'e> {
         view.intrinsics
             .project(&(view.rotation * self.points[k] + view.translation))
     }
+}
+
+/// The grid cell of `cell` pixels holding pixel `xy`.
+fn cell_of(xy: [f64; 2], cell: f64) -> (i64, i64) {
+    ((xy[0] / cell).floor() as i64, (xy[1] / cell).floor() as i64)
+}
+
+/// Cell `c` and its eight neighbours: every pixel within one cell's width of `c`'s.
+fn around(c: (i64, i64)) -> impl Iterator<Item = (i64, i64)> {
+    (c.0 - 1..=c.0 + 1).flat_map(move |x| (c.1 - 1..=c.1 + 1).map(move |y| (x, y)))
 }
 
 /// The evidence's matches between registered views.
