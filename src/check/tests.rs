@@ -1769,7 +1769,7 @@ fn counts(conflicting: usize, agreeing: usize) -> Counts {
 }
 
 /// Two images at one pose, each seeing its own half of a wall: each one's points project where
-/// the other has no keypoint at all. Bare samples, unjudged by default; with a bare weight they
+/// the other has no keypoint at all. Bare samples, unjudged at weight 0; with a bare weight they
 /// count, at that weight, as conflicts. An untriangulated keypoint next to a projection makes
 /// that sample neither bare nor judged.
 #[test]
@@ -1791,6 +1791,7 @@ fn a_projection_onto_no_keypoint_at_all_is_bare() {
     let mut with_keypoint = model(images.clone(), &points);
     let views = Views::new(&with_keypoint, 0.02, None).unwrap();
     let mut settings = DEFAULT_SETTINGS.conflict;
+    settings.bare_weight = 0.0;
     let unjudged = conflict::pair_counts(&views, 0, 1, &settings);
     assert_eq!(unjudged, Counts::default());
     settings.bare_weight = 0.5;

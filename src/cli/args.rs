@@ -222,7 +222,7 @@ pub struct CheckOptions {
     radius: f64,
     /// Expert: what a sample weighs, against a conflicting one, where the image has no keypoint
     /// at all near the projected point (a bare surface where the other group's structure is);
-    /// 0 leaves such samples unjudged. Measured, not yet the default (docs/check.md).
+    /// 0 leaves such samples unjudged (docs/check.md).
     #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.bare_weight, value_parser = fraction)]
     bare_weight: f64,
     /// Expert: images each group needs at least.

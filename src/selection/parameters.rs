@@ -474,11 +474,11 @@ mod tests {
         let recorded = serde_json::to_value(&defaults).unwrap();
         assert!(recorded.get("check").is_none(), "{recorded}");
         assert_eq!(Parameters::resolve(given(None)).unwrap(), defaults);
-        check.conflict.bare_weight = 0.5;
+        check.conflict.bare_weight = 0.25;
         let bare = Parameters::resolve(given(Some(check))).unwrap();
         assert_eq!(bare.arc_rules.check, check);
         let recorded = serde_json::to_value(&bare).unwrap();
-        assert_eq!(recorded["check"]["conflict"]["bare_weight"], 0.5);
+        assert_eq!(recorded["check"]["conflict"]["bare_weight"], 0.25);
         assert_eq!(
             serde_json::from_value::<Parameters>(recorded).unwrap(),
             bare
