@@ -197,46 +197,47 @@ fn lock_seconds(s: &str) -> Result<f64, String> {
 /// each folder, so that the loop judges as the check a user ran (each needs `--model`).
 #[derive(Args, Clone)]
 #[command(rename_all = "snake_case")]
+#[group(requires = "model", multiple = true)]
 pub struct CheckOptions {
     /// Score (conflicting over judged samples plus --prior) from which a model is ghosted.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.threshold, value_parser = fraction)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.threshold, value_parser = fraction)]
     threshold: f64,
     /// Expert: score under which a placement whose links the repair keeps (a ghost's group
     /// placed back, two clean models joined) is taken; from it up to --threshold, none is.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.placement_threshold, value_parser = fraction)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.placement_threshold, value_parser = fraction)]
     placement_threshold: f64,
     /// Expert: with the database, score from which one image alone is ghosted though its own
     /// matches place it where the model does.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.alone_threshold, value_parser = fraction)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.alone_threshold, value_parser = fraction)]
     alone_threshold: f64,
     /// Expert: largest angle (degrees) between two images' rays for one to be expected to see
     /// what the other saw.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_angle_deg)]
     max_angle: f64,
     /// Expert: largest ratio between two images' distances to a point for one to be expected to
     /// see what the other saw there.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.max_scale)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.max_scale)]
     max_scale: f64,
     /// Expert: neighbourhood radius around a projected point, as a fraction of the image diagonal.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.radius, value_parser = fraction)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.radius, value_parser = fraction)]
     radius: f64,
     /// Expert: what a sample weighs, against a conflicting one, where the image has no keypoint
     /// at all near the projected point (a bare surface where the other group's structure is);
     /// 0 leaves such samples unjudged (docs/check.md).
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.conflict.bare_weight, value_parser = fraction)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.bare_weight, value_parser = fraction)]
     bare_weight: f64,
     /// Expert: images each group needs at least.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.min_group)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.min_group)]
     min_group: usize,
     /// Expert: conflicting samples a ghosted split needs at least.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.min_conflicts)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.min_conflicts)]
     min_conflicts: usize,
     /// Expert: agreeing samples credited to a split of groups (a ratio over few samples counts
     /// less).
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.prior)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.prior)]
     prior: usize,
     /// Expert: agreeing samples credited to one image alone against the rest.
-    #[arg(long, requires = "model", default_value_t = DEFAULT_SETTINGS.alone_prior)]
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.alone_prior)]
     alone_prior: usize,
 }
 
