@@ -283,6 +283,54 @@ pub fn count_alone(views: &Views, reach: &Reach, b: usize, settings: &ConflictSe
     counts
 }
 
+/// For each view `v`, what each group of the split `side` saw alone (every other view of the
+/// group counted, `v` left out), judged in `v`: `[false side, true side]`. An image agrees
+/// with its own copy's structure and conflicts with the other's wherever the other copy's
+/// structure projects into it; this reads that per image against whole groups, where a link's
+/// count reads it against one other image, and a copy's images that see only the repeated
+/// object agree with the other copy's too (docs/check.md).
+pub fn leanings(
+    views: &Views,
+    reach: &Reach,
+    side: &[bool],
+    settings: &ConflictSettings,
+) -> Vec<[Counts; 2]> {
+    use rayon::prelude::*;
+    let mut within = vec![[0u32; 2]; views.points.len()];
+    for (k, track) in views.observers.iter().enumerate() {
+        track
+            .iter()
+            .for_each(|&v| within[k][usize::from(side[v])] += 1);
+    }
+    (0..side.len())
+        .into_par_iter()
+        .map(|v| {
+            let mut counts = [Counts::default(); 2];
+            let mut from: Vec<(usize, u32)> = Vec::new();
+            for &k in &reach.points[v] {
+                let g = match within[k] {
+                    [_, 0] => 0,
+                    [0, _] => 1,
+                    _ => continue,
+                };
+                if views.observers[k].binary_search(&v).is_ok() {
+                    continue;
+                }
+                from.clear();
+                from.extend(
+                    (views.observers[k].iter().copied()).zip(views.observed_at[k].iter().copied()),
+                );
+                // The points near the projection are `v`'s own: of group `g` through another
+                // view of it.
+                let own = u32::from(usize::from(side[v]) == g);
+                let ours = |j: usize| within[j][g] > own;
+                counts[g].add(judge(views, k, v, &from, &ours, settings));
+            }
+            counts
+        })
+        .collect()
+}
+
 /// How a sample ended.
 pub(super) enum Sample {
     /// Only the image's own group's structure near the projection.

@@ -1861,7 +1861,7 @@ fn the_splits_refined_are_the_worst_judged_first() {
     let worst = worst_split(scored.clone().into_iter(), &settings).unwrap();
     assert_eq!(worst.0, split(6));
     let mut candidates = splits::SplitList::default();
-    let refined = refined_splits(&scored, &[], &mut candidates, &settings);
+    let refined = improved_splits(&scored, &mut candidates, &settings, |s| s.to_vec());
     assert_eq!(refined.len(), super::REFINED);
     assert!(
         refined.contains(&splits::normalised(split(6))),
@@ -1906,4 +1906,55 @@ fn a_split_of_groups_is_credited_with_fewer_samples_than_one_image_alone() {
     assert!(score(&street, false, &settings) > settings.alone_threshold);
     let side = |k: usize| (0..8).map(|i| i < k).collect::<Vec<bool>>();
     assert!(alone(&side(1)) && alone(&side(7)) && !alone(&side(2)) && !alone(&side(6)));
+}
+
+/// The parity split of [`ghosted_model`] (each wall's six cameras) and the views of its model.
+fn ghost_views(model: &SparseModel) -> (Views<'_>, conflict::Reach, Vec<bool>) {
+    let settings = DEFAULT_SETTINGS;
+    let views = Views::new(model, settings.conflict.radius, None).unwrap();
+    let reach = conflict::Reach::new(&views, &settings.conflict);
+    let parity = (views.views.iter())
+        .map(|v| v.name[..4].parse::<u32>().unwrap() % 2 == 0)
+        .collect();
+    (views, reach, parity)
+}
+
+/// Against the two walls' own cameras, each camera agrees with its own wall's structure and
+/// conflicts with the other's wherever that projects into it.
+#[test]
+fn each_image_leans_to_its_own_copys_structure() {
+    let model = ghosted_model();
+    let (views, reach, parity) = ghost_views(&model);
+    let leanings = conflict::leanings(&views, &reach, &parity, &DEFAULT_SETTINGS.conflict);
+    let bare = DEFAULT_SETTINGS.conflict.bare_weight;
+    for (v, counts) in leanings.iter().enumerate() {
+        let [own, other] = [
+            counts[usize::from(parity[v])],
+            counts[usize::from(!parity[v])],
+        ];
+        assert!(own.agreeing + own.conflicting >= 20, "{v}: {own:?}");
+        assert!(other.agreeing + other.conflicting >= 20, "{v}: {other:?}");
+        assert!(own.ratio(bare) < 0.1, "{v}: {own:?}");
+        assert!(other.ratio(bare) > 0.5, "{v}: {other:?}");
+    }
+}
+
+/// From the copies with two cameras on the wrong side, the regrouping moves them back, one at
+/// a time, and stops at the copies; the copies themselves stay. On a correct model nothing
+/// leans either way: a split stays as given.
+#[test]
+fn regrouping_moves_images_to_the_copy_whose_structure_they_agree_with() {
+    let settings = DEFAULT_SETTINGS;
+    let model = ghosted_model();
+    let (views, reach, parity) = ghost_views(&model);
+    let mut off = parity.clone();
+    off[3] = !off[3];
+    off[8] = !off[8];
+    assert_eq!(regroup(&views, &reach, &off, &settings), parity);
+    assert_eq!(regroup(&views, &reach, &parity, &settings), parity);
+    let correct = correct_model();
+    let views = Views::new(&correct, settings.conflict.radius, None).unwrap();
+    let reach = conflict::Reach::new(&views, &settings.conflict);
+    let halves: Vec<bool> = (0..views.views.len()).map(|v| v % 3 == 0).collect();
+    assert_eq!(regroup(&views, &reach, &halves, &settings), halves);
 }
