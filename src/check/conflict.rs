@@ -60,14 +60,18 @@ impl Counts {
         self.conflicting as f64 + bare_weight * self.bare as f64
     }
 
-    /// [`Counts::conflicts`] over themselves and the agreeing samples; 0 without samples.
+    /// The judged samples: [`Counts::conflicts`] and the agreeing ones.
+    pub fn judged(&self, bare_weight: f64) -> f64 {
+        self.conflicts(bare_weight) + self.agreeing as f64
+    }
+
+    /// [`Counts::conflicts`] over [`Counts::judged`]; 0 without samples.
     pub fn ratio(&self, bare_weight: f64) -> f64 {
-        let conflicts = self.conflicts(bare_weight);
-        let judged = conflicts + self.agreeing as f64;
+        let judged = self.judged(bare_weight);
         if judged == 0.0 {
             0.0
         } else {
-            conflicts / judged
+            self.conflicts(bare_weight) / judged
         }
     }
 }
@@ -228,7 +232,7 @@ pub fn count(views: &Views, reach: &Reach, side: &[bool], settings: &ConflictSet
             [_, owner] => owner,
         };
         from.clear();
-        from.extend((views.observers[k].iter().copied()).zip(views.observed_at[k].iter().copied()));
+        from.extend(views.observations(k));
         let ours = |j: usize| member.of(j)[usize::from(owner)];
         for &b in reach.of(k).iter().filter(|&&b| side[b] != owner) {
             counts.add(judge(views, k, b, &from, &ours, settings));
@@ -270,11 +274,7 @@ pub fn count_alone(views: &Views, reach: &Reach, b: usize, settings: &ConflictSe
                 }
             }
             Err(_) => {
-                let from: Vec<(usize, u32)> = track
-                    .iter()
-                    .copied()
-                    .zip(views.observed_at[k].iter().copied())
-                    .collect();
+                let from: Vec<(usize, u32)> = views.observations(k).collect();
                 let ours = |j: usize| views.observers[j].iter().any(|&v| v != b);
                 counts.add(judge(views, k, b, &from, &ours, settings));
             }
@@ -317,9 +317,7 @@ pub fn leanings(
                     continue;
                 }
                 from.clear();
-                from.extend(
-                    (views.observers[k].iter().copied()).zip(views.observed_at[k].iter().copied()),
-                );
+                from.extend(views.observations(k));
                 // The points near the projection are `v`'s own: of group `g` through another
                 // view of it.
                 let own = u32::from(usize::from(side[v]) == g);

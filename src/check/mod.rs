@@ -527,7 +527,6 @@ fn regroup(
     settings: &CheckSettings,
 ) -> Vec<bool> {
     let bare_weight = settings.conflict.bare_weight;
-    let judged = |c: &Counts| c.conflicts(bare_weight) + c.agreeing as f64;
     let mut side = side.to_vec();
     let mut sizes = [0, 0];
     side.iter().for_each(|&s| sizes[usize::from(s)] += 1);
@@ -538,7 +537,9 @@ fn regroup(
                 &leanings[v][usize::from(side[v])],
                 &leanings[v][usize::from(!side[v])],
             ];
-            let enough = judged(own) >= REGROUP_MIN_JUDGED && judged(other) >= REGROUP_MIN_JUDGED;
+            let enough = [own, other]
+                .iter()
+                .all(|c| c.judged(bare_weight) >= REGROUP_MIN_JUDGED);
             (enough && sizes[usize::from(side[v])] > settings.min_group)
                 .then(|| own.ratio(bare_weight) - other.ratio(bare_weight))
         };

@@ -463,10 +463,7 @@ fn an_image_alone_is_counted_as_every_sample_of_its_split() {
         for v in 0..views.views.len() {
             let mut every = conflict::Counts::default();
             for (k, track) in views.observers.iter().enumerate() {
-                let observations = track
-                    .iter()
-                    .copied()
-                    .zip(views.observed_at[k].iter().copied());
+                let observations = views.observations(k);
                 match track.binary_search(&v) {
                     Ok(at) => {
                         every.seen += usize::from(track.len() > 1);

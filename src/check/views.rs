@@ -347,6 +347,11 @@ impl<'e> Views<'e> {
             .any(|q| (q[0] - at[0]).hypot(q[1] - at[1]) <= radius)
     }
 
+    /// Point `k`'s observations as (view, keypoint), in `observers`' order.
+    pub fn observations(&self, k: usize) -> impl Iterator<Item = (usize, u32)> + '_ {
+        (self.observers[k].iter().copied()).zip(self.observed_at[k].iter().copied())
+    }
+
     /// Pixel position of point `k` in view `v`, if in front and inside the image.
     pub fn project(&self, v: usize, k: usize) -> Option<[f64; 2]> {
         let view = &self.views[v];
