@@ -33,6 +33,20 @@ pub struct ConflictSettings {
     /// cameras see bare walls (the plain design's ghosts, docs/check.md). It weighs less than a
     /// conflict, as a textureless occluder or a feature budget leaves a place bare too.
     pub bare_weight: f64,
+    /// Images a triangulated point needs to count as its group's own structure in a split's
+    /// count ([`count`]; 2: every point). A point two images saw rests on one pair's matches
+    /// alone, and a false pair between repeated facades, which the epipolar test passes where
+    /// the cameras move along the repetition, puts such points off every surface while both
+    /// cameras stay right: they conflict wherever they project (docs/check.md). A point one
+    /// image observes, which no mapper keeps, still counts. Records made before it counted
+    /// every point.
+    #[serde(default = "every_point")]
+    pub min_track: usize,
+}
+
+/// [`ConflictSettings::min_track`] of records made before it: every point.
+fn every_point() -> usize {
+    2
 }
 
 /// Counts of one split, both directions together.
@@ -231,6 +245,9 @@ pub fn count(views: &Views, reach: &Reach, side: &[bool], settings: &ConflictSet
             }
             [_, owner] => owner,
         };
+        if (2..settings.min_track).contains(&views.observers[k].len()) {
+            continue;
+        }
         from.clear();
         from.extend(views.observations(k));
         let ours = |j: usize| member.of(j)[usize::from(owner)];

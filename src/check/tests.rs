@@ -190,6 +190,60 @@ fn a_ghosted_model_is_found_with_its_two_groups() {
     assert!(!worst.joining_pairs.is_empty());
 }
 
+/// A correct model whose two halves each kept a false pair's points: cameras along a wall
+/// (its lower half textured, seen by all), and above it, in the upper half, points that two
+/// neighbouring images of one half alone observe, placed at random: what false matches between
+/// repeated facades triangulate to when the cameras are right (one pair's matches, off every
+/// surface), each half's at other places than the other's.
+fn false_pairs_points_model() -> SparseModel {
+    let mut rng = Lcg(3);
+    let points: Vec<_> = wall(&mut rng, 3000, 0)
+        .into_iter()
+        .map(|(id, p)| (id, [p[0], -p[1].abs(), p[2]]))
+        .collect();
+    let mut images: Vec<SparseImage> = (0..12)
+        .map(|k| image(k + 1, -1.5 + 0.25 * k as f64, &points, 0.6, &mut rng))
+        .collect();
+    let mut all = points.clone();
+    for k in (0..12).step_by(2) {
+        // 200 points for the pair (k, k + 1), where both see them.
+        let phantoms: Vec<_> = (0..200u64)
+            .map(|j| {
+                let x = -1.5 + 0.25 * k as f64 + 2.0 * rng.next() - 1.0;
+                (
+                    100_000 + 1000 * k as u64 + j,
+                    [x, 0.5 + 1.5 * rng.next(), 5.0],
+                )
+            })
+            .collect();
+        for image in &mut images[k..k + 2] {
+            let seen = image_at(
+                0,
+                [-image.image.translation.x, 0.0],
+                &phantoms,
+                1.0,
+                &mut rng,
+            );
+            image.points2d.extend(seen.points2d);
+            image.image.observations = image.points2d.len();
+        }
+        all.extend(phantoms);
+    }
+    model(images, &all)
+}
+
+#[test]
+fn points_two_images_saw_do_not_make_a_correct_model_a_ghost() {
+    let model = false_pairs_points_model();
+    let check = check_model(&model, None, &DEFAULT_SETTINGS).unwrap();
+    assert!(!check.ghosted, "score {}", check.score);
+    // Counted as structure, each half's false points conflict with the other's.
+    let mut every_point = DEFAULT_SETTINGS;
+    every_point.conflict.min_track = 2;
+    let counted = check_model(&model, None, &every_point).unwrap();
+    assert!(counted.ghosted, "score {}", counted.score);
+}
+
 /// Three copies glued into one model: three differently textured walls at one place, each
 /// seen by every third camera, one object in front of them all.
 fn three_copies() -> SparseModel {

@@ -226,6 +226,10 @@ pub struct CheckOptions {
     /// 0 leaves such samples unjudged (docs/check.md).
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.bare_weight, value_parser = fraction)]
     bare_weight: f64,
+    /// Expert: observations a point needs to count as a group's own structure when a split is
+    /// scored (2: every point; a point two images saw rests on one pair's matches).
+    #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.min_track as u64, value_parser = clap::value_parser!(u64).range(2..))]
+    min_track: u64,
     /// Expert: images each group needs at least.
     #[arg(long, default_value_t = DEFAULT_SETTINGS.min_group)]
     min_group: usize,
@@ -252,6 +256,7 @@ impl CheckOptions {
         s.conflict.max_scale = self.max_scale.max(1.0);
         s.conflict.radius = self.radius;
         s.conflict.bare_weight = self.bare_weight;
+        s.conflict.min_track = self.min_track as usize;
         s.min_group = self.min_group.max(1);
         s.min_conflicts = self.min_conflicts;
         s.prior = self.prior;
