@@ -226,8 +226,8 @@ pub struct CheckOptions {
     /// 0 leaves such samples unjudged (docs/check.md).
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.bare_weight, value_parser = fraction)]
     bare_weight: f64,
-    /// Expert: observations a point needs to count as a group's own structure when a split is
-    /// scored (2: every point; a point two images saw rests on one pair's matches).
+    /// Expert: images a triangulated point needs to count as a group's own structure when a
+    /// split is scored (2: every point; a point two images saw rests on one pair's matches).
     #[arg(long, default_value_t = DEFAULT_SETTINGS.conflict.min_track as u64, value_parser = clap::value_parser!(u64).range(2..))]
     min_track: u64,
     /// Expert: images each group needs at least.
