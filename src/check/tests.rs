@@ -4,7 +4,7 @@
 
 use super::join::ApartReason;
 use super::repair::{blames, ModelEvidence};
-use super::resection::{DOMINANT_SUPPORT, THIRD_PLACE_SHARE};
+use super::resection::{DOMINANT_SUPPORT, THIRD_PLACE_RATIO, THIRD_PLACE_SHARE};
 use super::*;
 use crate::colmap::model::{ModelCamera, ModelImage};
 use crate::colmap::sparse::{Point2D, SparseImage};
@@ -1524,6 +1524,32 @@ fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
         );
         assert_eq!(evidence(with(held - 1)).1, ModelEvidence::default());
     }
+}
+
+/// An image whose matches' pose a third place rivals is not misplaced: its view repeats, and
+/// its matches do not say where it belongs (Cup's frame 0043 in a correct model: the model's
+/// pose 2262 correspondences, the matches' 3015 at 5% of the spread, a third place 3028). At
+/// [`THIRD_PLACE_RATIO`] times the third place it is; one correspondence fewer, it is not.
+#[test]
+fn an_image_whose_matches_a_third_place_rivals_is_not_misplaced() {
+    let placement = |support: usize, elsewhere: usize| resection::ImagePlacement {
+        image: "0043.jpg".into(),
+        correspondences: 9081,
+        model_support: 2262,
+        support,
+        elsewhere,
+        moved: 0.051,
+        links: Vec::new(),
+        against: Vec::new(),
+        holding: Vec::new(),
+    };
+    let cup = placement(3015, 3028);
+    assert!(cup.moves() && !cup.misplaced(), "{cup:?}");
+    let held = (THIRD_PLACE_RATIO * 3028.0).ceil() as usize;
+    assert!(placement(held, 3028).misplaced());
+    assert!(placement(held - 1, 3028).moves() && !placement(held - 1, 3028).misplaced());
+    // No third place (none sought, or none found): the model's pose is the only rival.
+    assert!(placement(3015, 0).misplaced());
 }
 
 /// Matches of a pair whose keypoints the model holds on different points (each point of `a` to
