@@ -13,17 +13,20 @@ Four kinds of work folder, as the scripts leave them:
   --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned and (GLOBAL=1)
                     global/sparse_full, global/sparse_pruned per scene with their databases;
                     truth: SUB.eval.json's, per sub-model, "unknown" without ground truth
-  --peers WORK      scripts/bench/disambiguation_peers.py's: its runs' truth (the judged frames)
+  --peers WORK ...  scripts/bench/disambiguation_peers.py's: its runs' truth (the judged frames;
+                    "unknown" where the reference is not trusted: Oats, Cereal)
 
 Prints one row per model folder (set, truth, exit status, verdict lines), then per set the
 counts of truth by verdict (exit status 0 clean, 3 wrong), and per sub-model the images
 the check calls unanchored (the report's `unanchored`: on no 3D point, or next to none) by
-truth. With --before BINARY (the check before a change), each model is checked by both and
+truth, and the threshold's range on the folders of one model: the highest worst split of
+groups of a correct model, the lowest of a wrong one flagged (an image alone has a threshold
+of its own). With --before BINARY (the check before a change), each model is checked by both and
 only the rows whose exit status or scores moved are printed, then the counts by truth, exit
 status before and after.
 
 usage: VGSEL=target/release/vgsel-colmap scripts/lab/recheck.py [--before BINARY]
-       [--loops DIR ...] [--pipelines DIR ...] [--scenes DIR ...] [--peers WORK]
+       [--loops DIR ...] [--pipelines DIR ...] [--scenes DIR ...] [--peers WORK ...]
 """
 import argparse
 import collections
@@ -70,10 +73,12 @@ def models(args):
             "peers", os.path.join(os.path.dirname(__file__), "../bench/disambiguation_peers.py"))
         peers = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(peers)
-        for measure in sorted(glob.glob(f"{args.peers}/*/measure")):
+        measures = (m for work in args.peers for m in sorted(glob.glob(f"{work}/*/measure")))
+        for measure in measures:
             if not os.path.exists(f"{measure}/truth.json"):
                 continue
-            uncertain = json.load(open(f"{measure}/truth.json"))["uncertain"]
+            reference = json.load(open(f"{measure}/truth.json"))
+            uncertain = reference["uncertain"]
             for path in sorted(glob.glob(f"{measure}/run_*.json")):
                 run = json.load(open(path))
                 if run["prune_args"] or run["order"] != "image_id" or run["models"] == 0:
@@ -81,6 +86,8 @@ def models(args):
                 judged = run["images"] - len(uncertain)
                 whole = run["registered"] == run["images"]
                 truth = "correct" if whole and run["correct_agreed"] == judged else "wrong"
+                if not reference.get("trusted", True):
+                    truth = "unknown"
                 yield "peers", truth, run["sparse"], peers.database(run)
 
 
@@ -98,20 +105,48 @@ def scores(report):
     return [round(m["score"], 3) for m in report["models"]] if report else None
 
 
+def group_splits(report):
+    """A folder of one model: its (score, ghosted) where its worst split is one of groups (an
+    image alone has a threshold of its own). A folder's truth is its one model's; of several,
+    it does not say which (an image registered twice is right in one)."""
+    models = report["models"] if report else []
+    if len(models) != 1:
+        return
+    groups = (models[0].get("worst") or {}).get("groups") or []
+    if groups and min(map(len, groups)) > 1:
+        yield 0, models[0]["score"], models[0].get("ghosted", False)
+
+
+def threshold_range(splits):
+    """The highest split of groups of a correct model and the lowest of a wrong one it flags:
+    any threshold between them flags every wrong model it flags now, and no correct one."""
+    correct = [(s, where) for truth, s, ghosted, where in splits if truth == "correct"]
+    flagged = [(s, where) for truth, s, ghosted, where in splits if ghosted and truth == "wrong"]
+    lines = ["\nworst splits of groups, folders of one model (the threshold's range on them):"]
+    if correct:
+        lines.append("correct models' highest %.3f (%s)" % max(correct))
+    if flagged:
+        lines.append("wrong models flagged: lowest %.3f (%s)" % min(flagged))
+    return lines
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--before", help="the vgsel-colmap binary before a change")
     parser.add_argument("--loops", nargs="*", default=[])
     parser.add_argument("--pipelines", nargs="*", default=[])
     parser.add_argument("--scenes", nargs="*", default=[])
-    parser.add_argument("--peers")
+    parser.add_argument("--peers", nargs="*", default=[])
     args = parser.parse_args()
     verdicts = collections.Counter()
     unanchored = collections.Counter()
+    splits = []
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "check.json")
         for kind, truth, model, db in models(args):
             status, lines, after = check(VGSEL, model, db, report)
+            splits += [(truth, score, ghosted, f"{model}/{k}")
+                       for k, score, ghosted in group_splits(after)]
             if args.before:
                 before_status, _, before = check(args.before, model, db, report)
                 verdicts[(kind, truth, before_status, status)] += 1
@@ -131,6 +166,7 @@ def main():
         print("\ntruth, some image unanchored: sub-models")
         for key, n in sorted(unanchored.items()):
             print(*key, n)
+    print("\n".join(threshold_range(splits)))
 
 
 if __name__ == "__main__":

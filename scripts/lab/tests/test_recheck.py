@@ -1,6 +1,7 @@
-"""recheck.py --before on pipeline.sh work folders laid out here, with two stand-in binaries:
-every run found at any depth (those with a database and a model), only the rows whose verdict
-or score moved printed, the counts by truth and exit status before and after."""
+"""recheck.py on pipeline.sh work folders laid out here, with two stand-in binaries: with
+--before, every run found at any depth (those with a database and a model), only the rows whose
+verdict or score moved printed, the counts by truth and exit status before and after; alone,
+the threshold's range over the worst splits of groups."""
 import json
 import os
 import tempfile
@@ -16,35 +17,43 @@ import json, os, sys
 a = sys.argv
 model, report = a[a.index("--model") + 1], a[a.index("--report") + 1]
 score = float(open(os.path.join(model, "{name}")).read())
-json.dump({{"models": [{{"score": score, "unanchored": []}}]}}, open(report, "w"))
+worst = {{"groups": [["a.png", "b.png"], ["c.png", "d.png"]]}}
+json.dump({{"models": [{{"score": score, "unanchored": [], "worst": worst,
+                         "ghosted": score >= 0.48}}]}}, open(report, "w"))
 print(model, "score", score)
 sys.exit(3 if score >= 0.48 else 0)
 """
 
 
+def lay_out(tmp):
+    """Stand-in binaries `before` and `after`, and pipeline work folders under tmp/top: a/c38
+    (full: correct, 0.9 after; pruned: wrong, 0.6 after) and b/x/g42 (full: correct, 0.1)."""
+    binaries = {}
+    for name in ("before", "after"):
+        binaries[name] = lab_tool.write_executable(os.path.join(tmp, name), FAKE.format(name=name))
+    # Two pipeline work folders, one nested deeper; a run without a model is skipped.
+    runs = {"a/c38": {"full": (0.9, 0.9, 10, 10), "pruned": (0.2, 0.6, 8, 10)},
+            "b/x/g42": {"full": (0.1, 0.1, 10, 10)}}
+    for work, variants in runs.items():
+        for variant, (before, after, correct, registered) in variants.items():
+            d = os.path.join(tmp, "top", work)
+            os.makedirs(os.path.join(d, f"sparse_{variant}/0"), exist_ok=True)
+            open(os.path.join(d, f"{variant}.db"), "w").close()
+            for name, score in (("before", before), ("after", after)):
+                with open(os.path.join(d, f"sparse_{variant}/{name}"), "w") as f:
+                    f.write(str(score))
+            with open(os.path.join(d, f"eval_{variant}.json"), "w") as f:
+                json.dump({"images": [], "correct": correct, "registered": registered}, f)
+        d = os.path.join(tmp, "top", work)
+        with open(os.path.join(d, "eval_repaired1.json"), "w") as f:
+            json.dump({"images": [], "correct": 10, "registered": 10}, f)
+    return binaries
+
+
 class Recheck(unittest.TestCase):
     def test_before_and_after_on_pipeline_folders(self):
         with tempfile.TemporaryDirectory() as tmp:
-            binaries = {}
-            for name in ("before", "after"):
-                binaries[name] = lab_tool.write_executable(os.path.join(tmp, name),
-                                                           FAKE.format(name=name))
-            # Two pipeline work folders, one nested deeper; a run without a model is skipped.
-            runs = {"a/c38": {"full": (0.9, 0.9, 10, 10), "pruned": (0.2, 0.6, 8, 10)},
-                    "b/x/g42": {"full": (0.1, 0.1, 10, 10)}}
-            for work, variants in runs.items():
-                for variant, (before, after, correct, registered) in variants.items():
-                    d = os.path.join(tmp, "top", work)
-                    os.makedirs(os.path.join(d, f"sparse_{variant}/0"), exist_ok=True)
-                    open(os.path.join(d, f"{variant}.db"), "w").close()
-                    for name, score in (("before", before), ("after", after)):
-                        with open(os.path.join(d, f"sparse_{variant}/{name}"), "w") as f:
-                            f.write(str(score))
-                    with open(os.path.join(d, f"eval_{variant}.json"), "w") as f:
-                        json.dump({"images": [], "correct": correct, "registered": registered}, f)
-                d = os.path.join(tmp, "top", work)
-                with open(os.path.join(d, "eval_repaired1.json"), "w") as f:
-                    json.dump({"images": [], "correct": 10, "registered": 10}, f)
+            binaries = lay_out(tmp)
             with mock.patch.dict(os.environ, {"VGSEL": binaries["after"]}):
                 out = lab_tool.run("recheck.py", "--before", binaries["before"],
                                    "--pipelines", os.path.join(tmp, "top"))
@@ -52,9 +61,18 @@ class Recheck(unittest.TestCase):
         self.assertEqual(len(rows), 1, out)
         self.assertIn("pipelines wrong", rows[0])
         self.assertIn("a/c38/sparse_pruned 0 [0.2] -> 3 [0.6]", rows[0])
-        counts = out[out.index("\nset, truth"):].splitlines()[2:]
+        counts = out[out.index("\nset, truth"):].splitlines()[2:5]
         self.assertEqual(counts, ["pipelines correct 0 0 1", "pipelines correct 3 3 1",
                                   "pipelines wrong 0 3 1"], out)
+
+    def test_the_thresholds_range(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            binaries = lay_out(tmp)
+            with mock.patch.dict(os.environ, {"VGSEL": binaries["after"]}):
+                out = lab_tool.run("recheck.py", "--pipelines", os.path.join(tmp, "top"))
+        lines = out[out.index("worst splits of groups"):].splitlines()
+        self.assertRegex(lines[1], r"^correct models' highest 0\.900 \(.*a/c38/sparse_full/0\)$")
+        self.assertRegex(lines[2], r"^wrong models flagged: lowest 0\.600 \(.*/sparse_pruned/0\)$")
 
 
 if __name__ == "__main__":
