@@ -86,7 +86,7 @@ def models(args):
                 judged = run["images"] - len(uncertain)
                 whole = run["registered"] == run["images"]
                 truth = "correct" if whole and run["correct_agreed"] == judged else "wrong"
-                if not reference.get("trusted", True):
+                if not reference["trusted"]:
                     truth = "unknown"
                 yield "peers", truth, run["sparse"], peers.database(run)
 
@@ -105,16 +105,17 @@ def scores(report):
     return [round(m["score"], 3) for m in report["models"]] if report else None
 
 
-def group_splits(report):
-    """A folder of one model: its (score, ghosted) where its worst split is one of groups (an
-    image alone has a threshold of its own). A folder's truth is its one model's; of several,
-    it does not say which (an image registered twice is right in one)."""
+def group_split(report):
+    """A folder of one model: its (score, ghosted, path) where its worst split is one of groups
+    (an image alone has a threshold of its own), else None. A folder's truth is its one model's; of
+    several, it does not say which (an image registered twice is right in one)."""
     models = report["models"] if report else []
     if len(models) != 1:
-        return
+        return None
     groups = (models[0].get("worst") or {}).get("groups") or []
-    if groups and min(map(len, groups)) > 1:
-        yield 0, models[0]["score"], models[0].get("ghosted", False)
+    if not groups or min(map(len, groups)) < 2:
+        return None
+    return models[0]["score"], models[0].get("ghosted", False), models[0]["model"]
 
 
 def threshold_range(splits):
@@ -145,8 +146,9 @@ def main():
         report = os.path.join(tmp, "check.json")
         for kind, truth, model, db in models(args):
             status, lines, after = check(VGSEL, model, db, report)
-            splits += [(truth, score, ghosted, f"{model}/{k}")
-                       for k, score, ghosted in group_splits(after)]
+            split = group_split(after)
+            if split:
+                splits.append((truth, *split))
             if args.before:
                 before_status, _, before = check(args.before, model, db, report)
                 verdicts[(kind, truth, before_status, status)] += 1

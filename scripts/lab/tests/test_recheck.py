@@ -18,8 +18,8 @@ a = sys.argv
 model, report = a[a.index("--model") + 1], a[a.index("--report") + 1]
 score = float(open(os.path.join(model, "{name}")).read())
 worst = {{"groups": [["a.png", "b.png"], ["c.png", "d.png"]]}}
-json.dump({{"models": [{{"score": score, "unanchored": [], "worst": worst,
-                         "ghosted": score >= 0.48}}]}}, open(report, "w"))
+json.dump({{"models": [{{"model": os.path.join(model, "0"), "score": score, "unanchored": [],
+                         "worst": worst, "ghosted": score >= 0.48}}]}}, open(report, "w"))
 print(model, "score", score)
 sys.exit(3 if score >= 0.48 else 0)
 """
