@@ -17,8 +17,9 @@
 #   CHECK_ONLY=1 only checks (and scores) the models a previous run built;
 #   IMAGES_LIMIT=N uses the first N images (by name) of a dataset; VGSEL the binary.
 # Truth: a model is ghosted when at least 2 and at least 20% of its registered images stand
-# more than 5% of the ground truth's extent from their true centres (eval); without ground
-# truth, topview.py's verdict (its camera path folds back in capture order) where it has one.
+# more than 5% of the ground truth's extent from their true centres (eval), clean when none
+# does; a few off between is listed, not judged (check-table.py); without ground truth,
+# topview.py's verdict (its camera path folds back in capture order) where it has one.
 # Models are cached in WORK/SCENE (delete it to redo); the check always runs again.
 set -euo pipefail
 [ $# -ge 1 ] || { echo "usage: $0 WORK [SCENE ...]" >&2; exit 2; }
