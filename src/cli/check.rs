@@ -20,6 +20,10 @@ use vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 /// 3D point.
 pub const EXIT_GHOSTED: u8 = 3;
 
+/// `--help`'s heading of the scoring options, after the inputs and outputs a user names.
+const SETTINGS: &str =
+    "The check's settings (all but --threshold for experts; `prune --model` takes the same)";
+
 #[derive(Args)]
 #[command(rename_all = "snake_case")]
 pub struct CheckArgs {
@@ -55,7 +59,7 @@ pub struct CheckArgs {
     /// two surfaces is folded.
     #[arg(long, requires = "database_path")]
     sequence: bool,
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = SETTINGS)]
     options: CheckOptions,
 }
 
