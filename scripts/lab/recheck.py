@@ -13,8 +13,9 @@ Four kinds of work folder, as the scripts leave them:
   --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned and (GLOBAL=1)
                     global/sparse_full, global/sparse_pruned per scene with their databases;
                     truth: SUB.eval.json's, per sub-model, "unknown" without ground truth
-  --peers WORK ...  scripts/bench/disambiguation_peers.py's: its runs' truth (the judged frames;
-                    "unknown" where the reference is not trusted: Oats, Cereal)
+  --peers WORK ...  scripts/bench/disambiguation_peers.py's: truth as for --loops over the judged
+                    frames (`eval` against the set's reference; "unknown" where the reference is
+                    not trusted: Oats, Cereal)
 
 Prints one row per model folder (set, truth, exit status, verdict lines), then per set the
 counts of truth by verdict (exit status 0 clean, 3 wrong), and per sub-model the images
@@ -83,12 +84,25 @@ def models(args):
                 run = json.load(open(path))
                 if run["prune_args"] or run["order"] != "image_id" or run["models"] == 0:
                     continue
-                judged = run["images"] - len(uncertain)
-                whole = run["registered"] == run["images"]
-                truth = "correct" if whole and run["correct_agreed"] == judged else "wrong"
-                if not reference["trusted"]:
-                    truth = "unknown"
+                truth = "unknown"
+                if reference["trusted"]:
+                    truth = peers_truth(run["sparse"], f"{measure}/truth_txt", uncertain)
                 yield "peers", truth, run["sparse"], peers.database(run)
+
+
+def peers_truth(sparse, reference, uncertain):
+    """A peers' run's truth as the other sets': correct when every judged frame it registered
+    is right, each registration of it (by `eval` against the reference; frames left
+    unregistered make a model smaller, not wrong), else wrong."""
+    out = subprocess.run([VGSEL, "eval", "--model", sparse, "--ground_truth", reference],
+                         capture_output=True, text=True, check=True)
+    e = json.loads(out.stdout)
+    judged = [i for i in e["images"] if i["name"] not in uncertain]
+    # `images` holds each frame's best registration; `wrong_registrations` counts every wrong
+    # one, so beyond the uncertain frames' it is a judged frame's second, wrong registration.
+    uncertain_wrong = sum(not i["correct"] for i in e["images"] if i["name"] in uncertain)
+    right = all(i["correct"] for i in judged) and e["wrong_registrations"] == uncertain_wrong
+    return "correct" if right else "wrong"
 
 
 def check(binary, model, db, report):

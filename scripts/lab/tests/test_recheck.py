@@ -74,6 +74,54 @@ class Recheck(unittest.TestCase):
         self.assertRegex(lines[1], r"^correct models' highest 0\.900 \(.*a/c38/sparse_full/0\)$")
         self.assertRegex(lines[2], r"^wrong models flagged: lowest 0\.600 \(.*/sparse_pruned/0\)$")
 
+    def test_peers_truth_is_the_registered_judged_frames(self):
+        """A peers' run is wrong where a judged frame it registered is wrong, once or in a second
+        registration; frames it left out, or uncertain ones wrong, leave it correct."""
+        # Each run's eval, as the stand-in binary prints it for its model folder.
+        runs = {
+            "left_out": {"images": [{"name": "a", "correct": True}], "wrong_registrations": 0},
+            "uncertain_wrong": {"images": [{"name": "a", "correct": True},
+                                           {"name": "u", "correct": False}],
+                                "wrong_registrations": 1},
+            "judged_wrong": {"images": [{"name": "a", "correct": False}],
+                             "wrong_registrations": 1},
+            "twice": {"images": [{"name": "a", "correct": True}], "wrong_registrations": 1},
+        }
+        with tempfile.TemporaryDirectory() as tmp:
+            fake = lab_tool.write_executable(os.path.join(tmp, "vgsel"), PEERS_FAKE)
+            measure = os.path.join(tmp, "work", "scene", "measure")
+            os.makedirs(measure)
+            with open(os.path.join(measure, "truth.json"), "w") as f:
+                json.dump({"trusted": True, "uncertain": ["u"]}, f)
+            for name, e in runs.items():
+                sparse = os.path.join(measure, f"sparse_{name}")
+                os.makedirs(os.path.join(sparse, "0"))
+                with open(os.path.join(sparse, "eval.json"), "w") as f:
+                    json.dump(e, f)
+                with open(os.path.join(measure, f"run_{name}.json"), "w") as f:
+                    json.dump({"prune_args": [], "order": "image_id", "models": 1,
+                               "sparse": sparse, "database": "db"}, f)
+            with mock.patch.dict(os.environ, {"VGSEL": fake}):
+                out = lab_tool.run("recheck.py", "--peers", os.path.join(tmp, "work"))
+        truth = {line.split()[2].rsplit("sparse_", 1)[1]: line.split()[1]
+                 for line in out.splitlines() if line.startswith("peers ") and "|" in line}
+        self.assertEqual(truth, {"left_out": "correct", "uncertain_wrong": "correct",
+                                 "judged_wrong": "wrong", "twice": "wrong"}, out)
+
+
+# A stand-in binary for the peers' runs: `eval` prints the model folder's eval.json, `check`
+# calls every model clean.
+PEERS_FAKE = """#!/usr/bin/env python3
+import json, os, sys
+a = sys.argv
+model = a[a.index("--model") + 1]
+if a[1] == "eval":
+    print(open(os.path.join(model, "eval.json")).read())
+else:
+    json.dump({"models": []}, open(a[a.index("--report") + 1], "w"))
+    print(model, "clean")
+"""
+
 
 if __name__ == "__main__":
     unittest.main()
