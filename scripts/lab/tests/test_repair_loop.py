@@ -1,6 +1,7 @@
 """scripts/repair_loop.py: the share of the pruned selection's pairs the full model's ghost blames
-decides whether the repair loop takes that model's evidence (full-model); a turn that leaves the
-same pairs and inliers valid as the last run's database is not mapped (same-selection)."""
+decides whether the repair loop takes that model's evidence (full-model), and so does a clean
+pruned model that places each of the ghost's groups as it does (same-ghost); a turn that leaves
+the same pairs and inliers valid as the last run's database is not mapped (same-selection)."""
 import json
 import os
 import sqlite3
@@ -57,6 +58,62 @@ class FullModelEvidence(unittest.TestCase):
     def test_a_model_without_a_ghost_is_not_taken_whatever_it_blames(self):
         blamed = [["a.png", "b.png"], ["b.png", "c.png"], ["c.png", "d.png"]]
         self.assertEqual(self.decide(False, blamed), (1, "0 (no ghost)"))
+
+
+# A stand-in `vgsel-colmap eval`: the images it scores correct against each ground-truth
+# model, from placed.json beside it; a model it has none for fails, as eval does without an
+# image in common.
+FAKE_EVAL = """#!/usr/bin/env python3
+import json, os, sys
+placed = json.load(open(os.path.join(os.path.dirname(sys.argv[0]), "placed.json")))
+truth = sys.argv[sys.argv.index("--ground_truth") + 1]
+if truth not in placed:
+    sys.exit("no image in common")
+print(json.dumps({"images": [{"name": n, "correct": c} for n, c in placed[truth].items()]}))
+"""
+
+
+class SameGhost(unittest.TestCase):
+    def same(self, placed, ghosted=True):
+        """Exit status and output of same-ghost for a full model whose sub-model 1 is ghosted
+        (or not) with groups a-e and f-h, sub-model 0 clean, the pruned model placing the images
+        of `placed` ({name: as the ghost does?}) against sub-model 1."""
+        with tempfile.TemporaryDirectory() as tmp:
+            fake = os.path.join(tmp, "vgsel")
+            with open(fake, "w") as f:
+                f.write(FAKE_EVAL)
+            os.chmod(fake, 0o755)
+            json.dump({"full/1": placed, "full/0": {"x.png": True}},
+                      open(os.path.join(tmp, "placed.json"), "w"))
+            worst = {"groups": [["a", "b", "c", "d", "e"], ["f", "g", "h"]]}
+            report = os.path.join(tmp, "check.json")
+            json.dump({"models": [{"ghosted": False, "model": "full/0", "worst": worst},
+                                  {"ghosted": ghosted, "model": "full/1", "worst": worst},
+                                  {"ghosted": True, "model": "full/2", "worst": worst}]},
+                      open(report, "w"))
+            out = subprocess.run([sys.executable, SCRIPT, "same-ghost", fake, report, "pruned"],
+                                 capture_output=True, text=True)
+        return out.returncode, out.stdout.strip()
+
+    def test_each_group_placed_as_the_ghost_places_it_is_the_same_ghost(self):
+        # Four in five of the first group, every one of the second; an image the ghost does not
+        # hold counts for nothing; sub-model 2 has no image in common.
+        placed = {"a": True, "b": True, "c": True, "d": True, "e": False,
+                  "f": True, "g": True, "h": True, "z": False}
+        self.assertEqual(self.same(placed), (0, "0.80 1.00"))
+
+    def test_one_group_placed_elsewhere_is_not(self):
+        # A correct model where the ghost moved its second group: that group is placed
+        # elsewhere, however well the first agrees.
+        placed = {n: True for n in "abcde"} | {"f": True, "g": False, "h": False}
+        self.assertEqual(self.same(placed), (1, "1.00 0.33"))
+
+    def test_a_group_with_cameras_left_out_is_not(self):
+        placed = {"a": True, "b": True, "c": True, "f": True, "g": True, "h": True}
+        self.assertEqual(self.same(placed), (1, "0.60 1.00"))
+
+    def test_without_a_ghost_it_is_not(self):
+        self.assertEqual(self.same({n: True for n in "abcdefgh"}, ghosted=False)[0], 1)
 
 
 class SameSelection(unittest.TestCase):
