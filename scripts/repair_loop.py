@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Two decisions of scripts/pipeline.sh's repair loop, also for a loop run by hand (README,
+"""Three decisions of scripts/pipeline.sh's repair loop, also for a loop run by hand (README,
 "Is the model ghosted?"; docs/check.md, "The full model in the loop").
 
 full-model: whether the loop takes the full database's model as evidence: where the check calls
