@@ -81,7 +81,7 @@ def same_ghost(vgsel, check_json, pruned_model):
         if best is None or min(shares) > min(best):
             best = shares
     if best is None:
-        return False, "0 (no ghost)"
+        return False, "0 (no ghosted model with cameras in common)"
     return min(best) >= MIN_SAME, " ".join(f"{share:.2f}" for share in best)
 
 
