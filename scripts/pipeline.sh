@@ -201,6 +201,13 @@ map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer" \
   "$work"/check_*.json
 last=pruned models=() earlier=() answer= full_evidence=
+# The full model's evidence taken (for the reason `$1` says): the first model of every turn's
+# prune and every check's earlier model, and the pruned run no answer.
+take_full_model() {
+  log "$1: its evidence comes first"
+  full_evidence=1 models=(--model "$work/sparse_full")
+  earlier=(--earlier_model "$work/sparse_full")
+}
 # The full database's model is evidence too where the check calls it ghosted and the pruned
 # selection kept what glued it: the pruned model can be the same ghost, hidden from the check
 # (the twin: docs/check.md, "The full model in the loop", scripts/repair_loop.py), so
@@ -213,9 +220,7 @@ if [ "${REPAIR:-0}" -gt 0 ] && made_model full; then
   cat "$work/check_full.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   if share=$("$here/scripts/repair_loop.py" full-model "$work/check_full.json" "$work/pruned.db"); then
-    log "the full model's ghost blames $share of the pruned selection: its evidence comes first"
-    full_evidence=1 models=(--model "$work/sparse_full")
-    earlier=(--earlier_model "$work/sparse_full")
+    take_full_model "the full model's ghost blames $share of the pruned selection"
   fi
 fi
 # Every model is checked, the last turn's too, after the models before it (a clean model's
@@ -240,9 +245,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   if [ "$status" = 0 ] && [ "$last" = pruned ] && [ -z "$full_evidence" ] &&
     [ -f "$work/check_full.json" ] && shares=$("$here/scripts/repair_loop.py" same-ghost \
       "$bin" "$work/check_full.json" "$work/sparse_pruned"); then
-    log "the pruned model places the full model's ghost as it does ($shares of its groups): its evidence comes first"
-    full_evidence=1 models=(--model "$work/sparse_full")
-    earlier=(--earlier_model "$work/sparse_full")
+    take_full_model "the pruned model places the full model's ghost as it does ($shares of its groups)"
   fi
   # A clean verdict answers, but the pruned run's where the full model's ghost came first:
   # there it is that ghost hidden (the twin's, every one at hand).

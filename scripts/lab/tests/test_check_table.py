@@ -59,7 +59,8 @@ class CheckTable(unittest.TestCase):
         self.assertIn("few off", out)
         self.assertNotIn("disagrees", out)
         self.assertIn("every verdict right for thresholds in (0.280, 0.600]", out)
-        self.assertEqual([r["truth"] for r in table["rows"]], [True, False, None, None, False, True, None])
+        self.assertEqual([r["truth"] for r in table["rows"]],
+                         [True, False, None, None, False, True, None])
         self.assertEqual(table["threshold_range"], [0.28, 0.6])
 
 
