@@ -239,7 +239,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
     --report "$work/check_$last.json" $check_args >"$work/check_$last.txt" || status=$?
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
-  # A clean pruned model that places each group of the full model's ghost as that model does
+  # A clean pruned model that places most of each group of the full model's ghost as it does
   # is that ghost, hidden from the check (the plain design at 38 images): the full model's
   # evidence comes first after all, whatever share of the selection it blames.
   if [ "$status" = 0 ] && [ "$last" = pruned ] && [ -z "$full_evidence" ] &&

@@ -12,14 +12,15 @@ costs cameras (a 44-image street's image 0034 lost; on another street 19 of 44 r
 loop without it gave 44). Prints the share.
 
 same-ghost: whether the pruned model, which the check calls clean, is the full model's ghost
-again: four in five cameras of each of the ghost's two groups placed as the full model places
-them (`vgsel-colmap eval` of the pruned model against that ghosted model, its 5% and 5 degrees).
+again: most cameras of each of the ghost's two groups placed as the full model places them
+(`vgsel-colmap eval` of the pruned model against that ghosted model, its 5% and 5 degrees).
 The check then cannot see a ghost the full model shows, and the loop takes the full model's
 evidence whatever its share: the plain design at 38 images, 38 of 38 cameras where the full
 ghost has them and 17% of the kept pairs blamed. Over 82 stored loops whose full model was
 ghosted, pruned models that were that ghost placed 0.88-1.00 of each group so, correct pruned
-models at most 0.41 (docs/check.md, "The pruned model as the full model's ghost"). Prints the
-two groups' shares.
+models at most 0.41; a fresh plain scene's pruned ghost 0.57, its copy's cameras moved about
+by its own misplacements (docs/check.md, "The pruned model as the full model's ghost"). Prints
+the two groups' shares.
 
 same-selection: whether two databases leave the same pairs valid with the same inliers: a turn
 whose prune selects what the last run mapped would only map it again.
@@ -42,8 +43,8 @@ import sys
 # (0.35) and the twin's smallest (0.47).
 MIN_SHARE = 0.4
 # The share of each of the full ghost's groups the pruned model must place as the ghost does:
-# between correct pruned models' 0.41 and the same ghost's 0.88.
-MIN_SAME = 0.8
+# most of it, above correct pruned models' 0.41 (the same ghost: 0.57-1.00).
+MIN_SAME = 0.5
 # COLMAP's pair_id: image_id1 * MAX_IMAGES + image_id2, image_id1 < image_id2.
 MAX_IMAGES = 2147483647
 

@@ -96,11 +96,11 @@ class SameGhost(unittest.TestCase):
         return out.returncode, out.stdout.strip()
 
     def test_each_group_placed_as_the_ghost_places_it_is_the_same_ghost(self):
-        # Four in five of the first group, every one of the second; an image the ghost does not
-        # hold counts for nothing; sub-model 2 has no image in common.
-        placed = {"a": True, "b": True, "c": True, "d": True, "e": False,
-                  "f": True, "g": True, "h": True, "z": False}
-        self.assertEqual(self.same(placed), (0, "0.80 1.00"))
+        # Three in five of the first group (most of it), two of three of the second; an image
+        # the ghost does not hold counts for nothing; sub-model 2 has no image in common.
+        placed = {"a": True, "b": True, "c": True, "d": False, "e": False,
+                  "f": True, "g": True, "h": False, "z": False}
+        self.assertEqual(self.same(placed), (0, "0.60 0.67"))
 
     def test_one_group_placed_elsewhere_is_not(self):
         # A correct model where the ghost moved its second group: that group is placed
@@ -109,8 +109,8 @@ class SameGhost(unittest.TestCase):
         self.assertEqual(self.same(placed), (1, "1.00 0.33"))
 
     def test_a_group_with_cameras_left_out_is_not(self):
-        placed = {"a": True, "b": True, "c": True, "f": True, "g": True, "h": True}
-        self.assertEqual(self.same(placed), (1, "0.60 1.00"))
+        placed = {"a": True, "b": True, "f": True, "g": True, "h": True}
+        self.assertEqual(self.same(placed), (1, "0.40 1.00"))
 
     def test_without_a_ghost_it_is_not(self):
         self.assertEqual(self.same({n: True for n in "abcdefgh"}, ghosted=False)[0], 1)
