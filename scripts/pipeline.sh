@@ -36,13 +36,15 @@
 #                   every model so far and one more mapper run, a row `repairedK` per turn
 #                   [0]; the full database's model is checked too: where it is ghosted and
 #                   the pruned selection kept what glued it, or the pruned model the check
-#                   calls clean places that ghost's groups as it does (scripts/repair_loop.py),
+#                   calls clean places most of that ghost's groups as it does (repair_loop.py),
 #                   it is the first of those models and the first turn runs whatever the
 #                   pruned model's check says; a turn whose prune selects what the last run
 #                   mapped ends the loop; in the loop's runs, the pruned one's too,
-#                   the images the database links and COLMAP 3.8's mapper left out (a piece
-#                   the blame cut off: COLMAP 3.8 starts no second model from narrow pairs)
-#                   are mapped on their own into sparse_VARIANT/left, counted in the mapper's
+#                   the images the database links and an incremental mapper left out (a
+#                   piece the blame cut off: COLMAP 3.8 starts no second model from narrow
+#                   pairs, and COLMAP drops models under 10 images) are mapped on their own,
+#                   pieces of 3 kept (scripts/map-left-out.sh), into sparse_VARIANT/left,
+#                   counted in the mapper's
 #                   seconds (README); a run whose mapper makes no model (COLMAP 3.8 found no
 #                   initial pair: an outcome, recorded as such) ends the loop, the model
 #                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
@@ -153,8 +155,10 @@ rm -f "$work/sparse_pruned.seconds"
 # its first run left out, mapped into sparse_VARIANT/left; its seconds are added to the run's.
 map_left_out() {
   local variant=$1 sparse=$work/sparse_$1 first seconds
-  seconds=$(timed "$work/left_$variant.log" env VGSEL="$bin" "$here/scripts/map-left-out.sh" \
-    "$work/$variant.db" "$images" "$sparse" --Mapper.extract_colors 0)
+  local with=(VGSEL="$bin") options=(--Mapper.extract_colors 0)
+  [ "$mapper" = colmap3.8 ] || with+=(PYCOLMAP="$py") options=()
+  seconds=$(timed "$work/left_$variant.log" env "${with[@]}" "$here/scripts/map-left-out.sh" \
+    "$work/$variant.db" "$images" "$sparse" "${options[@]}")
   [ -s "$sparse.left.txt" ] &&
     log "mapper on the $(wc -l <"$sparse.left.txt") images the $variant model left out"
   first=$(cat "$sparse.seconds.part")
@@ -174,12 +178,6 @@ map_and_eval() {
       tolerated="failed to create sparse model" timed "$work/mapper_$variant.log" colmap mapper \
         --database_path "$work/$variant.db" --image_path "$images" --output_path "$sparse" \
         --Mapper.extract_colors 0 >"$sparse.seconds.part"
-      # The loop maps the images a run left out on their own before checking it, the pruned
-      # run's too: a piece that starts a model stays apart, only images that start none are
-      # placed by their matches (docs/check.md, "Cameras lost beside a clean model").
-      if [[ $variant == repaired* ]] || { [ "$variant" = pruned ] && [ "${REPAIR:-0}" -gt 0 ]; }; then
-        map_left_out "$variant"
-      fi
     else
       # COLMAP 4 migrates the database it opens: it maps a copy, so that every database here
       # stays as its matcher wrote it. No model at all is an outcome, an empty folder.
@@ -187,6 +185,13 @@ map_and_eval() {
       timed "$work/mapper_$variant.log" "$py" "$here/scripts/ci/colmap4.py" map "$mapper" \
         "$work/mapper_$variant.db" "$images" "$sparse" >"$sparse.seconds.part"
       rm -f "$work/mapper_$variant.db"
+    fi
+    # The loop maps the images an incremental run left out on their own before checking it,
+    # the pruned run's too: a piece that starts a model stays apart, only images that start
+    # none are placed by their matches (docs/check.md, "Cameras lost beside a clean model").
+    if [ "$mapper" != global ] && { [[ $variant == repaired* ]] ||
+      { [ "$variant" = pruned ] && [ "${REPAIR:-0}" -gt 0 ]; }; }; then
+      map_left_out "$variant"
     fi
     # The seconds mark the run done: written once it is (a failed run leaves none).
     mv "$sparse.seconds.part" "$sparse.seconds"

@@ -335,6 +335,79 @@ fn prune_after_colmap4_migration_then_restore() {
     assert_eq!(read42(f, &after), read42(f, &migrated));
 }
 
+/// scripts/map-left-out.sh with COLMAP 4.2's incremental mapper (`PYCOLMAP`): a run given all
+/// but three pieces of four images, which no verified pair links to each other (the rows
+/// deleted, as a turn's blame can cut them apart; `colmap4.py map --image_list`), leaves them
+/// out. The script maps them on their own into SPARSE/left, prints and lists them, and keeps
+/// more than the first piece, which COLMAP alone does not (it drops a later model under 10
+/// images: the twin's orbit in pieces of 3-5, docs/check.md), so `check` finds fewer left
+/// out; the database stays as it was (COLMAP 4 maps a copy).
+#[test]
+fn left_out_pieces_are_mapped_by_colmap4_on_their_own() {
+    let Some(f) = fixture() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let db = copy(&f.db42, dir, "db.db");
+    let pieces = [0..4, 7..11, 14..18];
+    let conn = rusqlite::Connection::open(&db).unwrap();
+    let id = |k: u32| -> u32 {
+        let name = format!("{k:04}.png");
+        let sql = "SELECT image_id FROM images WHERE name = ?1";
+        conn.query_row(sql, [name], |r| r.get(0)).unwrap()
+    };
+    for (i, a) in pieces.iter().enumerate() {
+        for b in &pieces[i + 1..] {
+            for (a, b) in a.clone().flat_map(|a| b.clone().map(move |b| (a, b))) {
+                let pair = vgsel_colmap::colmap::ids::pair_id(id(a), id(b)) as i64;
+                let sql = "DELETE FROM two_view_geometries WHERE pair_id = ?1";
+                conn.execute(sql, [pair]).unwrap();
+            }
+        }
+    }
+    drop(conn);
+    let given: Vec<String> = (0..20)
+        .filter(|k| !pieces.iter().any(|p| p.contains(k)))
+        .map(|k| format!("{k:04}.png\n"))
+        .collect();
+    let list = dir.join("given.txt");
+    std::fs::write(&list, given.concat()).unwrap();
+    let sparse = dir.join("sparse");
+    let map = [
+        "map".as_ref(),
+        "incremental".as_ref(),
+        &*db,
+        &f.images,
+        &sparse,
+    ];
+    colmap4(
+        &f.python,
+        &[&map[..], &["--image_list".as_ref(), &*list]].concat(),
+    );
+    let before = std::fs::read(&db).unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/map-left-out.sh");
+    let out = run_ok(
+        Command::new(script)
+            .env("VGSEL", env!("CARGO_BIN_EXE_vgsel-colmap"))
+            .env("PYCOLMAP", &f.python)
+            .args([&db, &f.images, &sparse]),
+    );
+    let listed = std::fs::read_to_string(sparse.with_extension("left.txt")).unwrap();
+    assert_eq!(listed.lines().count(), 12, "{listed}");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "12");
+    let models = std::fs::read_dir(sparse.join("left")).unwrap().count();
+    assert!(models >= 2, "{models} models of the three pieces");
+    let again = dir.join("unregistered_again.txt");
+    let check = Command::new(env!("CARGO_BIN_EXE_vgsel-colmap"))
+        .args(["check", "--model", s(&sparse), "--database_path", s(&db)])
+        .args(["--unregistered", s(&again)])
+        .output()
+        .unwrap();
+    assert!(matches!(check.status.code(), Some(0 | 3)), "{check:?}");
+    let again = std::fs::read_to_string(&again).unwrap();
+    assert!(again.lines().count() <= 12 - 3 * models, "{again}");
+    assert_eq!(std::fs::read(&db).unwrap(), before);
+}
+
 /// What users mixing versions meet (docs/colmap4.md): COLMAP 3.8 refuses a database COLMAP 4
 /// made, after rewriting its user_version to 3800; COLMAP 4 still reads it as before, and
 /// vgsel-colmap prunes and restores it.

@@ -11,9 +11,11 @@ scripts/ci/pycolmap-venv.sh creates.
   colmap4.py dump DB
       what COLMAP 4 reads from DB: one JSON object per two-view geometry (pair, config,
       inliers, F/E/H, relative pose) on stdout. Opening migrates DB, as any COLMAP 4 tool does.
-  colmap4.py map incremental|global DB IMAGES OUT
+  colmap4.py map incremental|global DB IMAGES OUT [--image_list FILE] [--min_model_size N]
       runs the mapper; writes every model as text into OUT/0, OUT/1, ... and prints a JSON
-      summary (models, registered images of the largest, seconds).
+      summary (models, registered images of the largest, seconds). The incremental mapper
+      can be given only the images FILE names (one a line) and a smaller model to keep than
+      COLMAP's 10 (the repair loop's left-out pass, scripts/map-left-out.sh).
 """
 import argparse
 import json
@@ -79,6 +81,10 @@ def run_mapper(args):
     if args.kind == "incremental":
         options = pycolmap.IncrementalPipelineOptions()
         options.extract_colors = False
+        if args.image_list:
+            options.image_names = open(args.image_list).read().split()
+        if args.min_model_size:
+            options.min_model_size = args.min_model_size
         run = pycolmap.incremental_mapping
     else:
         options = pycolmap.GlobalPipelineOptions()
@@ -121,8 +127,12 @@ def main():
     p.add_argument("images")
     p.add_argument("out")
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--image_list")
+    p.add_argument("--min_model_size", type=int)
     p.set_defaults(func=run_mapper)
     args = parser.parse_args()
+    if args.command == "map" and args.kind == "global" and (args.image_list or args.min_model_size):
+        parser.error("--image_list and --min_model_size are the incremental mapper's")
     args.func(args)
 
 
