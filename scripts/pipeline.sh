@@ -44,10 +44,9 @@
 #                   piece the blame cut off: COLMAP 3.8 starts no second model from narrow
 #                   pairs, and COLMAP drops models under 10 images) are mapped on their own,
 #                   pieces of 3 kept (scripts/map-left-out.sh), into sparse_VARIANT/left,
-#                   counted in the mapper's
-#                   seconds (README); a run whose mapper makes no model (COLMAP 3.8 found no
-#                   initial pair: an outcome, recorded as such) ends the loop, the model
-#                   before it stands; the loop's answer (WORKDIR/answer, summary.json's
+#                   counted in the mapper's seconds (README); a run whose mapper makes no
+#                   model (COLMAP 3.8 found no initial pair: an outcome, recorded as such)
+#                   ends the loop, the model before it stands; the loop's answer (WORKDIR/answer, summary.json's
 #                   loop_answer) is its last run the check calls clean (not the pruned run
 #                   where the full model's evidence came first), else its last run, or the
 #                   full run where the pruned one made no model
