@@ -29,6 +29,10 @@ set -euo pipefail
 [ $# -ge 3 ] || { sed -n '18,27p' "$0" >&2; exit 2; }
 db=$1 images=$2 sparse=$3
 shift 3
+if [ -n "${PYCOLMAP:-}" ] && [ $# -gt 0 ]; then
+  echo "map-left-out: mapper options are COLMAP 3.8's; with PYCOLMAP give none" >&2
+  exit 2
+fi
 bin=${VGSEL:-vgsel-colmap}
 list=$sparse.left.txt
 rm -f "$list"
