@@ -46,10 +46,11 @@
 #                   pieces of 3 kept (scripts/map-left-out.sh), into sparse_VARIANT/left,
 #                   counted in the mapper's seconds (README); a run whose mapper makes no
 #                   model (COLMAP 3.8 found no initial pair: an outcome, recorded as such)
-#                   ends the loop, the model before it stands; the loop's answer (WORKDIR/answer, summary.json's
-#                   loop_answer) is its last run the check calls clean (not the pruned run
-#                   where the full model's evidence came first), else its last run, or the
-#                   full run where the pruned one made no model
+#                   ends the loop, the model before it stands; the loop's answer
+#                   (WORKDIR/answer, summary.json's loop_answer) is its last run the check
+#                   calls clean (not the pruned run where the full model's evidence came
+#                   first), else its last run, or the full run where the pruned one made no
+#                   model
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 # This checkout, or the package's copy of its scripts (/usr/share/vgsel-colmap, run as

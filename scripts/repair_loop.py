@@ -66,8 +66,8 @@ def full_model(check_json, pruned_db):
 
 
 def same_ghost(vgsel, check_json, pruned_model):
-    """Whether the pruned model places each group of a ghosted full model as that model does,
-    and the shares of the closest one (as printed)."""
+    """Whether the pruned model places most of each group of a ghosted full model as that
+    model does, and the shares of the closest one (as printed)."""
     best = None
     for model in json.load(open(check_json))["models"]:
         if not model["ghosted"] or not model.get("worst"):

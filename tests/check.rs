@@ -750,10 +750,10 @@ fn check_flags_the_plain_designs_ghost_by_what_its_cameras_do_not_see() {
 /// model shows it (its copies' surroundings conflict); the pruned selection leaves too little
 /// of them, and the check calls the pruned model clean. Its blame is 17% of the pruned
 /// selection, under the 40% that takes the full model's evidence, but the pruned model places
-/// most of each of the ghost's groups as the full model does (`repair_loop.py same-ghost`), so the
-/// loop takes that evidence first, and its answer has every camera right (fresh seeds 5604,
-/// 5606 and 5607 in session 56, three mappers: 19 of 38 before, 37-38 after). About a minute
-/// and a half on 2 cores.
+/// most of each of the ghost's groups as the full model does (`repair_loop.py same-ghost`), so
+/// the loop takes that evidence first, and its answer has every camera right (fresh plain
+/// scenes of sessions 56-57, three mappers: 19 of 38 before, 38 after in 19 of 24 loops).
+/// About a minute and a half on 2 cores.
 #[test]
 fn the_repair_loop_sees_the_full_models_ghost_in_a_pruned_model_called_clean() {
     let (_dir, work) = pipeline(SceneKind::Plain, 38, 3);
