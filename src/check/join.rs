@@ -193,13 +193,13 @@ impl From<&Similarity> for Placement {
     }
 }
 
-/// An earlier run's ghosted model, as a later run's joins need it: the two groups of images it
-/// put onto each other (its worst split), whose placement of one in the other's frame
-/// conflicted, and where it put their cameras. Two models of a later run that lie on its two
-/// sides were placed so once already, and refuted: a placement of theirs that puts them where
-/// the ghost had them is that refuted placement again (the twin's two orbits, each a clean
-/// model after the repair, proposed onto each other as the full database's ghost had them, at
-/// 0.47 where the ghost scored 0.78; docs/check.md).
+/// An earlier run's ghosted model, as a later run's joins and misplaced images need it: the two
+/// groups of images it put onto each other (its worst split), whose placement of one in the
+/// other's frame conflicted, and where it put their cameras. Two models of a later run that
+/// lie on its two sides were placed so once already, and refuted: a placement of theirs that
+/// puts them where the ghost had them is that refuted placement again (the twin's two orbits,
+/// each a clean model after the repair, proposed onto each other as the full database's ghost
+/// had them, at 0.47 where the ghost scored 0.78; docs/check.md).
 #[derive(Clone, Debug)]
 pub struct Glued {
     /// The two groups, image names.
@@ -236,23 +236,58 @@ impl Glued {
     /// beside `a`'s: within [`MISPLACED_DISTANCE`] of their spread (median), once `a`'s cameras
     /// are carried onto the ghost's. False where the cameras they share fix no frame.
     pub fn repeated_by(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> bool {
-        let shared = |m: &SparseModel| -> (Vec<ModelImage>, Vec<ModelImage>) {
-            let on = m.images.iter().filter_map(|im| {
-                let ghost = self.cameras.get(&im.image.name)?;
-                Some((im.image.clone(), ghost.clone()))
-            });
-            on.unzip()
-        };
-        let ((a_here, a_ghost), (b_here, b_ghost)) = (shared(a), shared(b));
-        let to_ghost = Similarity::fit(&camera_points(&a_here), &camera_points(&a_ghost));
-        let Some(to_ghost) = to_ghost.filter(|_| !b_here.is_empty()) else {
+        let (b_here, b_ghost) = self.shared(b.images.iter());
+        let Some(to_ghost) = self
+            .to_ghost(a.images.iter())
+            .filter(|_| !b_here.is_empty())
+        else {
             return false;
         };
         let off = b_here.iter().zip(&b_ghost).map(|(here, ghost)| {
             (to_ghost.apply(&placement.apply(&here.centre())) - ghost.centre()).norm()
         });
+        median(off) <= MISPLACED_DISTANCE * self.spread()
+    }
+
+    /// Whether a pose of `image` with camera centre `centre` in `model`'s frame puts it where
+    /// this ghost had it beside its other group: within [`MISPLACED_DISTANCE`] of the ghost's
+    /// spread, once `model`'s cameras of that group are carried onto the ghost's. An image that
+    /// sees only an object both copies show alike (an orbit's end) matches the other copy's
+    /// images as well as its own neighbours, and its matches' pose can be that ghost's pose of
+    /// it again (plain 38-5604 and 38-5714, 0.002-0.007; the images truly misplaced in the
+    /// stored loops, 0.22 or more: docs/check.md).
+    pub fn places_again(&self, model: &SparseModel, image: &str, centre: &Vector3<f64>) -> bool {
+        let Some(side) = (0..2).find(|&k| self.groups[k].iter().any(|n| n == image)) else {
+            return false;
+        };
+        let other =
+            (model.images.iter()).filter(|im| self.groups[1 - side].contains(&im.image.name));
+        let (Some(to_ghost), Some(ghost)) = (self.to_ghost(other), self.cameras.get(image)) else {
+            return false;
+        };
+        (to_ghost.apply(centre) - ghost.centre()).norm() <= MISPLACED_DISTANCE * self.spread()
+    }
+
+    /// The cameras of `images` this ghost has too: as given, and as the ghost had them.
+    fn shared<'m>(
+        &self,
+        images: impl Iterator<Item = &'m SparseImage>,
+    ) -> (Vec<ModelImage>, Vec<ModelImage>) {
+        (images
+            .filter_map(|im| Some((im.image.clone(), self.cameras.get(&im.image.name)?.clone()))))
+        .unzip()
+    }
+
+    /// The similarity that carries the cameras of `images` this ghost has onto the ghost's.
+    fn to_ghost<'m>(&self, images: impl Iterator<Item = &'m SparseImage>) -> Option<Similarity> {
+        let (here, ghost) = self.shared(images);
+        Similarity::fit(&camera_points(&here), &camera_points(&ghost))
+    }
+
+    /// The spread of the ghost's cameras (median distance to their centroid).
+    fn spread(&self) -> f64 {
         let ghost: Vec<Vector3<f64>> = self.cameras.values().map(ModelImage::centre).collect();
-        median(off) <= MISPLACED_DISTANCE * spread_of(&ghost)
+        spread_of(&ghost)
     }
 }
 

@@ -26,6 +26,7 @@ use crate::colmap::sparse::SparseModel;
 use anyhow::Result;
 use conflict::Counts;
 use evidence::{registered, Evidence};
+use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::Serialize;
 use settings::{enough_conflicts, is_ghost, score};
@@ -797,7 +798,9 @@ pub fn check_run<'e>(
                 // be one image off, not two groups.
                 if let (false, Some(views)) = (c.ghosted && c.ghost_placement.is_some(), &c.views) {
                     let mut images = resection::misplaced_images(views)?;
-                    images.retain(|m| placed_elsewhere(m, &c.unanchored));
+                    images.retain(|m| {
+                        placed_elsewhere(m, &c.unanchored) && !placed_as_before(m, model, earlier)
+                    });
                     c.misplaced_images = images;
                 }
                 if c.ghosted && !c.misplaced_images.is_empty() {
@@ -862,6 +865,18 @@ fn alone_placed_here(
 /// false). Such an image is told as unanchored, not as placed elsewhere.
 fn placed_elsewhere(placement: &resection::ImagePlacement, unanchored: &[String]) -> bool {
     placement.misplaced() && !unanchored.contains(&placement.image)
+}
+
+/// Whether an earlier run's ghost had the image where its matches put it now
+/// ([`join::Glued::places_again`]): that pose glued the copies once and was refuted, so the
+/// matches that give it again say nothing against the model.
+fn placed_as_before(
+    placement: &resection::ImagePlacement,
+    model: &SparseModel,
+    earlier: &[join::Glued],
+) -> bool {
+    let centre = Vector3::from(placement.centre);
+    (earlier.iter()).any(|g| g.places_again(model, &placement.image, &centre))
 }
 
 /// Each image of [`Evidence::lost_images`] that no model of `models` registered, placed in the

@@ -109,6 +109,8 @@ pub struct ImagePlacement {
     /// How far the matches' pose moves the camera centre, over the model's spread (the median
     /// distance of its points to their centroid).
     pub moved: f64,
+    /// The camera centre of the matches' pose, in the model's frame.
+    pub centre: [f64; 3],
     /// The pairs (this image, another) with at least [`PAIR_MIN_CORRESPONDENCES`]
     /// correspondences, at least half of them agreeing with the matches' pose, and no fewer
     /// than agree with the model's: for a misplaced image, they place it back (`prune --model`
@@ -121,9 +123,9 @@ pub struct ImagePlacement {
     pub against: Vec<[String; 2]>,
     /// The matches whose correspondence agrees with the model's pose and is far from the
     /// matches' ([`HOLDING_FAR`]): for a misplaced image, what holds it where the model put
-    /// it, inside pairs that may be true (a hall camera registered 98 degrees off onto an object's repeated
-    /// face by a few dozen such matches among its true pairs' inliers). `prune --model` drops
-    /// them from the pairs it keeps (in the report under `repair`).
+    /// it, inside pairs that may be true (a hall camera registered 98 degrees off onto an
+    /// object's repeated face by a few dozen such matches among its true pairs' inliers).
+    /// `prune --model` drops them from the pairs it keeps (in the report under `repair`).
     #[serde(skip)]
     pub holding: Vec<PairMatches>,
 }
@@ -445,7 +447,8 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
             last.2.push(matched);
         }
     }
-    let moved = (-(rotation.transpose() * translation) - view.centre).norm() / spread;
+    let centre = -(rotation.transpose() * translation);
+    let moved = (centre - view.centre).norm() / spread;
     let named = |w: usize| [view.name.clone(), views.views[w].name.clone()];
     let judged = pairs.iter().filter(|p| p.1[0] >= PAIR_MIN_CORRESPONDENCES);
     let list = |keep: &dyn Fn(&[usize; 3]) -> bool| -> Vec<[String; 2]> {
@@ -471,6 +474,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
         support,
         elsewhere: 0,
         moved,
+        centre: centre.into(),
         links,
         against,
         holding,

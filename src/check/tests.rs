@@ -1346,6 +1346,38 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     assert!(bare.models[0].misplaced_images.is_empty());
 }
 
+/// The misplaced image of the test above, where an earlier run's ghost had it where its
+/// matches put it now beside the other group's cameras (the ghost in a frame of its own): that
+/// placement was refuted already, and the model is clean. A ghost that had it half a unit
+/// elsewhere, or that split other groups, refutes nothing.
+#[test]
+fn an_image_placed_where_an_earlier_ghost_had_it_is_not_misplaced() {
+    let (model, evidence) = with_shift(1.0);
+    let image = "0005.png".to_string();
+    let rest = |m: &SparseModel| -> Vec<String> {
+        let names = m.images.iter().map(|im| im.image.name.clone());
+        names.filter(|n| *n != image).collect()
+    };
+    let ghost_with = |shift: f64| {
+        let (_, ghost) = two_models(&with_shift(shift).0, |_| true, 0, &elsewhere());
+        join::Glued::new(&ghost, [vec![image.clone()], rest(&model)])
+    };
+    let check = |earlier: &[join::Glued]| {
+        let models = std::slice::from_ref(&model);
+        let run = check_run(models, Some(&evidence), &DEFAULT_SETTINGS, earlier);
+        run.unwrap().models.remove(0)
+    };
+    let refuted = check(&[ghost_with(0.0)]);
+    assert!(refuted.misplaced_images.is_empty() && !refuted.wrong());
+    for earlier in [
+        ghost_with(0.5),
+        join::Glued::new(&model, [rest(&model), Vec::new()]),
+    ] {
+        let c = check(&[earlier]);
+        assert_eq!(c.misplaced_images.len(), 1, "{:?}", c.misplaced_images);
+    }
+}
+
 /// A ghost of two groups of two images whose split joins a-c (sharing points) and b-d (not),
 /// with `images` its matches place elsewhere (`of_images`: they are the ghost), and its second
 /// group `placed` or not.
@@ -1412,6 +1444,7 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
         support: 90,
         elsewhere: 0,
         moved: 0.3,
+        centre: [0.0; 3],
         links: vec![["c.png".into(), "b.png".into()]],
         against: vec![["c.png".into(), "d.png".into()]],
         holding: vec![resection::PairMatches {
@@ -1478,6 +1511,7 @@ fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
         support: 500,
         elsewhere,
         moved: 0.3,
+        centre: [0.0; 3],
         links: vec![["c.png".into(), "b.png".into()]],
         against: vec![["c.png".into(), "d.png".into()]],
         holding: vec![resection::PairMatches {
@@ -1539,6 +1573,7 @@ fn an_image_whose_matches_a_third_place_rivals_is_not_misplaced() {
         support,
         elsewhere,
         moved: 0.051,
+        centre: [0.0; 3],
         links: Vec::new(),
         against: Vec::new(),
         holding: Vec::new(),

@@ -570,6 +570,7 @@ mod tests {
                 support,
                 elsewhere,
                 moved: 2.4,
+                centre: [0.0; 3],
                 links: vec![["c.png".into(), "b.png".into()]],
                 against: Vec::new(),
                 holding: Vec::new(),
