@@ -765,8 +765,9 @@ pub struct RunCheck<'e> {
 }
 
 /// Checks every model of one mapper run and, with `evidence`, places the two groups of each
-/// clean one ([`join::place_group`]) and joins the models still clean (`earlier`: the ghosts
-/// of the repair loop's earlier runs, [`RunCheck::glued`]).
+/// clean one ([`join::place_group`]) and joins the models still clean. `earlier`, the ghosts
+/// of the repair loop's earlier runs ([`RunCheck::glued`]), refute the joins and the misplaced
+/// images that would put copies where those ghosts had them.
 pub fn check_run<'e>(
     models: &[SparseModel],
     evidence: Option<&'e Evidence>,
