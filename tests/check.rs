@@ -752,7 +752,7 @@ fn check_flags_the_plain_designs_ghost_by_what_its_cameras_do_not_see() {
 /// selection, under the 40% that takes the full model's evidence, but the pruned model places
 /// most of each of the ghost's groups as the full model does (`repair_loop.py same-ghost`), so
 /// the loop takes that evidence first, and its answer has every camera right (fresh plain
-/// scenes of sessions 56-57, three mappers: 19 of 38 before, 38 after in 19 of 24 loops).
+/// scenes of sessions 56-58, three mappers: 19 of 38 before, 38 after in 26 of 29 loops).
 /// About a minute and a half on 2 cores.
 #[test]
 fn the_repair_loop_sees_the_full_models_ghost_in_a_pruned_model_called_clean() {

@@ -1349,7 +1349,7 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
 /// The misplaced image of the test above, where an earlier run's ghost had it where its
 /// matches put it now beside the other group's cameras (the ghost in a frame of its own): that
 /// placement was refuted already, and the model is clean. A ghost that had it half a unit
-/// elsewhere, or that split other groups, refutes nothing.
+/// elsewhere, or whose groups do not hold it, refutes nothing.
 #[test]
 fn an_image_placed_where_an_earlier_ghost_had_it_is_not_misplaced() {
     let (model, evidence) = with_shift(1.0);

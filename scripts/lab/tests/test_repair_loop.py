@@ -1,7 +1,8 @@
 """scripts/repair_loop.py: the share of the pruned selection's pairs the full model's ghost blames
 decides whether the repair loop takes that model's evidence (full-model), and so does a clean
-pruned model that places most of each of the ghost's groups as it does (same-ghost); a turn that leaves
-the same pairs and inliers valid as the last run's database is not mapped (same-selection)."""
+pruned model that places most of each of the ghost's groups as it does (same-ghost); a turn
+that leaves the same pairs and inliers valid as the last run's database is not mapped
+(same-selection)."""
 import json
 import os
 import sqlite3
