@@ -8,6 +8,7 @@ Standard library only, so that the system python runs it.
 import contextlib
 import csv
 import glob
+import json
 import os
 import re
 import subprocess
@@ -162,6 +163,17 @@ def loop_runs(work):
         variant = os.path.basename(ev)[len("eval_"):-len(".json")]
         yield (f"{loop}/sparse_{variant}", f"{loop}/{variant}.db", f"{loop}/full.db",
                f"{work}/scene/gt", ev)
+
+
+def turn_models(work, variant):
+    """The model folders a repair turn of `work` took as evidence (`prune --model`, in the
+    order given: its prune_VARIANT.json's parameters), which the pipeline then checked its run
+    after (`--earlier_model`); none for the full and pruned runs."""
+    report = f"{work}/prune_{variant}.json"
+    if variant in ("full", "pruned") or not os.path.exists(report):
+        return []
+    with open(report) as f:
+        return json.load(f)["parameters"].get("model") or []
 
 
 def pipeline_runs(top):

@@ -9,7 +9,9 @@ Four kinds of work folder, as the scripts leave them:
                     camera correct
   --pipelines DIR ...  every scripts/pipeline.sh work folder found under each DIR (an
                     `eval_full.json` beside `full.db`): each run's model with its database and
-                    eval (ground truth given to the pipeline); truth as for --loops
+                    eval (ground truth given to the pipeline); truth as for --loops; with
+                    --as_looped, each repair turn's run is checked after the runs that turn
+                    took as evidence (`--earlier_model`), as the loop checked it
   --scenes DIR ...  scripts/lab/check-scenes.sh's: sparse_full, sparse_pruned and (GLOBAL=1)
                     global/sparse_full, global/sparse_pruned per scene with their databases;
                     truth: SUB.eval.json's, per sub-model, "unknown" without ground truth
@@ -27,7 +29,8 @@ only the rows whose exit status or scores moved are printed, then the counts by 
 status before and after.
 
 usage: VGSEL=target/release/vgsel-colmap scripts/lab/recheck.py [--before BINARY]
-       [--loops DIR ...] [--pipelines DIR ...] [--scenes DIR ...] [--peers WORK ...]
+       [--loops DIR ...] [--pipelines DIR ... [--as_looped]] [--scenes DIR ...]
+       [--peers WORK ...]
 """
 import argparse
 import collections
@@ -44,18 +47,22 @@ VGSEL = os.environ.get("VGSEL", "target/release/vgsel-colmap")
 
 
 def models(args):
-    """(set, truth, model folder, database) for every model at hand."""
+    """(set, truth, model folder, database, earlier model folders) for every model at hand."""
     for work in args.loops:
         for model, db, _, _, ev in colmap_files.loop_runs(work):
             e = json.load(open(ev))
             truth = "correct" if colmap_files.every_camera_right(e) else "wrong"
-            yield "loops", truth, model, db
+            yield "loops", truth, model, db, []
     for top in args.pipelines:
         for model, db, ev in colmap_files.pipeline_runs(top):
             e = json.load(open(ev))
             if "images" in e:
                 truth = "correct" if colmap_files.every_camera_right(e) else "wrong"
-                yield "pipelines", truth, model, db
+                work, variant = os.path.split(model)
+                earlier = []
+                if args.as_looped:
+                    earlier = colmap_files.turn_models(work, variant[len("sparse_"):])
+                yield "pipelines", truth, model, db, earlier
     for work in args.scenes:
         for scene in sorted(glob.glob(f"{work}/*/full.db")):
             d = os.path.dirname(scene)
@@ -68,7 +75,7 @@ def models(args):
                     e = json.load(open(ev)) if os.path.exists(ev) else {}
                     truth = ("unknown" if "images" not in e else
                              "correct" if colmap_files.every_camera_right(e) else "wrong")
-                    yield "scenes", truth, sub, os.path.join(d, db)
+                    yield "scenes", truth, sub, os.path.join(d, db), []
     if args.peers:
         spec = importlib.util.spec_from_file_location(
             "peers", os.path.join(os.path.dirname(__file__), "../bench/disambiguation_peers.py"))
@@ -87,7 +94,7 @@ def models(args):
                 truth = "unknown"
                 if reference["trusted"]:
                     truth = peers_truth(run["sparse"], f"{measure}/truth_txt", uncertain)
-                yield "peers", truth, run["sparse"], peers.database(run)
+                yield "peers", truth, run["sparse"], peers.database(run), []
 
 
 def peers_truth(sparse, reference, uncertain):
@@ -105,11 +112,13 @@ def peers_truth(sparse, reference, uncertain):
     return "correct" if right else "wrong"
 
 
-def check(binary, model, db, report):
-    """`binary check` of one model folder: its exit status, verdict lines and report (None
-    where it failed)."""
-    out = subprocess.run([binary, "check", "--model", model, "--database_path", db,
-                          "--report", report], capture_output=True, text=True)
+def check(binary, model, db, report, earlier):
+    """`binary check` of one model folder after the `earlier` ones: its exit status, verdict
+    lines and report (None where it failed)."""
+    command = [binary, "check", "--model", model, "--database_path", db, "--report", report]
+    for folder in earlier:
+        command += ["--earlier_model", folder]
+    out = subprocess.run(command, capture_output=True, text=True)
     ok = out.returncode in (0, 3)
     return out.returncode, out.stdout.splitlines(), json.load(open(report)) if ok else None
 
@@ -150,6 +159,8 @@ def main():
     parser.add_argument("--before", help="the vgsel-colmap binary before a change")
     parser.add_argument("--loops", nargs="*", default=[])
     parser.add_argument("--pipelines", nargs="*", default=[])
+    parser.add_argument("--as_looped", action="store_true",
+                        help="check each repair turn's run after the runs it took as evidence")
     parser.add_argument("--scenes", nargs="*", default=[])
     parser.add_argument("--peers", nargs="*", default=[])
     args = parser.parse_args()
@@ -158,13 +169,13 @@ def main():
     splits = []
     with tempfile.TemporaryDirectory() as tmp:
         report = os.path.join(tmp, "check.json")
-        for kind, truth, model, db in models(args):
-            status, lines, after = check(VGSEL, model, db, report)
+        for kind, truth, model, db, earlier in models(args):
+            status, lines, after = check(VGSEL, model, db, report, earlier)
             split = group_split(after)
             if split:
                 splits.append((truth, *split))
             if args.before:
-                before_status, _, before = check(args.before, model, db, report)
+                before_status, _, before = check(args.before, model, db, report, earlier)
                 verdicts[(kind, truth, before_status, status)] += 1
                 if (before_status, scores(before)) != (status, scores(after)):
                     print(kind, truth, model, before_status, scores(before), "->", status,

@@ -1,7 +1,8 @@
 """recheck.py on pipeline.sh work folders laid out here, with two stand-in binaries: with
 --before, every run found at any depth (those with a database and a model), only the rows whose
 verdict or score moved printed, the counts by truth and exit status before and after; alone,
-the threshold's range over the worst splits of groups."""
+the threshold's range over the worst splits of groups; with --as_looped, a repair turn's run
+checked after the runs it took as evidence."""
 import json
 import os
 import tempfile
@@ -107,6 +108,42 @@ class Recheck(unittest.TestCase):
                  for line in out.splitlines() if line.startswith("peers ") and "|" in line}
         self.assertEqual(truth, {"left_out": "correct", "uncertain_wrong": "correct",
                                  "judged_wrong": "wrong", "twice": "wrong"}, out)
+
+    def test_as_looped_checks_a_turn_after_the_runs_it_took(self):
+        """With --as_looped, a repair turn's run is checked after the folders its prune took
+        (prune_VARIANT.json), in their order; the full and pruned runs, and every run
+        without it, alone."""
+        with tempfile.TemporaryDirectory() as tmp:
+            fake = lab_tool.write_executable(os.path.join(tmp, "vgsel"), EARLIER_FAKE)
+            work = os.path.join(tmp, "top", "w")
+            for variant in ("full", "pruned", "repaired1"):
+                os.makedirs(os.path.join(work, f"sparse_{variant}", "0"))
+                open(os.path.join(work, f"{variant}.db"), "w").close()
+                with open(os.path.join(work, f"eval_{variant}.json"), "w") as f:
+                    json.dump({"images": [], "correct": 3, "registered": 3}, f)
+            taken = [os.path.join(work, "sparse_full"), os.path.join(work, "sparse_pruned")]
+            with open(os.path.join(work, "prune_repaired1.json"), "w") as f:
+                json.dump({"parameters": {"model": taken}}, f)
+            with mock.patch.dict(os.environ, {"VGSEL": fake}):
+                looped = lab_tool.run("recheck.py", "--pipelines", os.path.join(tmp, "top"),
+                                      "--as_looped")
+                alone = lab_tool.run("recheck.py", "--pipelines", os.path.join(tmp, "top"))
+
+        def after(out):
+            rows = [line.split("| ")[1] for line in out.splitlines() if "| " in line]
+            return {row.split()[0].rsplit("sparse_", 1)[1]: row.split()[2:] for row in rows}
+        self.assertEqual(after(looped), {"full": [], "pruned": [], "repaired1": taken}, looped)
+        self.assertEqual(after(alone), {"full": [], "pruned": [], "repaired1": []}, alone)
+
+
+# A stand-in `vgsel-colmap check` that prints the folders it was given as earlier runs.
+EARLIER_FAKE = """#!/usr/bin/env python3
+import json, sys
+a = sys.argv
+earlier = [a[k + 1] for k, arg in enumerate(a) if arg == "--earlier_model"]
+json.dump({"models": []}, open(a[a.index("--report") + 1], "w"))
+print(a[a.index("--model") + 1], "after", *earlier)
+"""
 
 
 # A stand-in binary for the peers' runs: `eval` prints the model folder's eval.json, `check`
