@@ -800,7 +800,9 @@ pub fn check_run<'e>(
                 if let (false, Some(views)) = (c.ghosted && c.ghost_placement.is_some(), &c.views) {
                     let mut images = resection::misplaced_images(views)?;
                     images.retain(|m| {
-                        placed_elsewhere(m, &c.unanchored) && !placed_as_before(m, model, earlier)
+                        let centre = Vector3::from(m.centre);
+                        placed_elsewhere(m, &c.unanchored)
+                            && !placed_as_before(model, &m.image, &centre, earlier)
                     });
                     c.misplaced_images = images;
                 }
@@ -823,7 +825,7 @@ pub fn check_run<'e>(
         None => join::Joins::default(),
     };
     let rejoined = match evidence {
-        Some(e) => rejoin(models, &checks, e)?,
+        Some(e) => rejoin(models, &checks, e, earlier)?,
         None => Vec::new(),
     };
     Ok(RunCheck {
@@ -868,25 +870,28 @@ fn placed_elsewhere(placement: &resection::ImagePlacement, unanchored: &[String]
     placement.misplaced() && !unanchored.contains(&placement.image)
 }
 
-/// Whether an earlier run's ghost had the image where its matches put it now
-/// ([`join::Glued::places_again`]): that pose glued the copies once and was refuted, so the
-/// matches that give it again say nothing against the model.
+/// Whether an earlier run's ghost had `image` where a pose with camera centre `centre` in
+/// `model`'s frame puts it ([`join::Glued::places_again`]): that pose glued the copies once and
+/// was refuted, so matches that give it again say nothing against the model, and place no
+/// lost image.
 fn placed_as_before(
-    placement: &resection::ImagePlacement,
     model: &SparseModel,
+    image: &str,
+    centre: &Vector3<f64>,
     earlier: &[join::Glued],
 ) -> bool {
-    let centre = Vector3::from(placement.centre);
-    (earlier.iter()).any(|g| g.places_again(model, &placement.image, &centre))
+    (earlier.iter()).any(|g| g.places_again(model, image, centre))
 }
 
 /// Each image of [`Evidence::lost_images`] that no model of `models` registered, placed in the
 /// clean model whose points most of its matches agree with ([`resection::place_lost`]);
-/// a ghosted or misplaced model is no frame to place it in.
+/// a ghosted or misplaced model is no frame to place it in. A pose where an `earlier` run's
+/// ghost had the image is refuted, as for a misplaced image ([`placed_as_before`]).
 fn rejoin(
     models: &[SparseModel],
     checks: &[ModelCheck],
     evidence: &Evidence,
+    earlier: &[join::Glued],
 ) -> Result<Vec<resection::Rejoin>> {
     let registered = registered(models);
     let lost: Vec<_> = (evidence.lost_images.iter())
@@ -901,7 +906,8 @@ fn rejoin(
         .map(|(name, image)| {
             let mut best: Option<resection::Rejoin> = None;
             for frame in &clean {
-                let found = resection::place_lost(frame, name, image)?;
+                let refuted = |c: &Vector3<f64>| placed_as_before(frame.model, name, c, earlier);
+                let found = resection::place_lost(frame, name, image, &refuted)?;
                 if let Some(r) =
                     found.filter(|r| best.as_ref().is_none_or(|b| r.support > b.support))
                 {

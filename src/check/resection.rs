@@ -269,6 +269,9 @@ pub struct Rejoin {
     pub correspondences: usize,
     /// Those the pose projects within [`AGREE_PX`].
     pub support: usize,
+    /// The pose is the matches' second place: an earlier run's ghost had the image at the
+    /// first ([`super::join::Glued::places_again`]).
+    pub second_place: bool,
     /// The pairs (this image, another) with at least [`PAIR_MIN_CORRESPONDENCES`]
     /// correspondences, at least half of them agreeing with the pose: `prune --model` keeps
     /// them.
@@ -308,8 +311,17 @@ impl<'a> Frame<'a> {
 /// database's: the pose most of them agree with, where at least [`MIN_SUPPORT`] do (COLMAP's
 /// mapper registers an image with 30 inliers, `abs_pose_min_num_inliers`) and no third place
 /// holds [`THIRD_PLACE_SHARE`] of them, beside that pose and the best of the rest (its other
-/// copy): a lost street camera's matches put it on every copy.
-pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option<Rejoin>> {
+/// copy): a lost street camera's matches put it on every copy. Where `refuted` says an
+/// earlier run's ghost had the image at the first pose, it is placed at the second, its other
+/// copy, if that is not refuted too: an orbit's end that sees only an object both copies show
+/// alike is placed first where the ghost had it, through the very pairs that ghost glued
+/// (plain 38-5716, docs/check.md).
+pub fn place_lost(
+    frame: &Frame,
+    name: &str,
+    image: &LostImage,
+    refuted: &dyn Fn(&Vector3<f64>) -> bool,
+) -> Result<Option<Rejoin>> {
     let views = frame.views;
     // In view order, as a registered image's correspondences are (the RANSAC's draws follow it).
     let mut matched: Vec<(usize, &[[u32; 2]])> = (image.matches.iter())
@@ -331,35 +343,32 @@ pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option
             }
         }
     }
-    if c.len() < MIN_SUPPORT {
-        return Ok(None);
-    }
     let camera = (frame.model.cameras.iter()).find(|c| c.camera_id == image.camera_id);
     let intrinsics = Intrinsics::from_camera(camera.unwrap_or(&image.camera));
-    let Some((rotation, translation)) = pnp(views, &intrinsics, &c)? else {
+    // The best pose, the best of what it leaves (its other copy), and a third.
+    let first = best_place(views, &intrinsics, &c)?;
+    let second = best_place(views, &intrinsics, &first.rest)?;
+    if !one_place(
+        best_place(views, &intrinsics, &second.rest)?.support,
+        c.len(),
+    ) {
+        return Ok(None);
+    }
+    let refuted = |p: &Place| p.pose.is_some_and(|pose| refuted(&centre_of(&pose)));
+    let (place, second_place) = match refuted(&first) {
+        false => (first, false),
+        true if !refuted(&second) => (second, true),
+        true => return Ok(None),
+    };
+    let Some(pose) = place.pose.filter(|_| place.support >= MIN_SUPPORT) else {
         return Ok(None);
     };
     // Per other view: correspondences, and those agreeing with the pose.
     let mut per_view: BTreeMap<usize, [usize; 2]> = BTreeMap::new();
-    let mut rest = Vec::new();
     for k in &c {
-        let agrees =
-            reprojection_error(views, &intrinsics, (&rotation, &translation), k) <= AGREE_PX;
+        let agrees = reprojection_error(views, &intrinsics, (&pose.0, &pose.1), k) <= AGREE_PX;
         let counts = per_view.entry(k.view).or_default();
         *counts = [counts[0] + 1, counts[1] + usize::from(agrees)];
-        if !agrees {
-            rest.push(*k);
-        }
-    }
-    let support = per_view.values().map(|n| n[1]).sum();
-    if support < MIN_SUPPORT {
-        return Ok(None);
-    }
-    // Its other copy may be a second place (the demo's first image, left out, matches both
-    // objects); a third is a street's.
-    let (_, rest) = best_pose(views, &intrinsics, &rest)?;
-    if !one_place(best_pose(views, &intrinsics, &rest)?.0, c.len()) {
-        return Ok(None);
     }
     let mut links = Vec::new();
     for (w, [n, s]) in per_view {
@@ -371,29 +380,46 @@ pub fn place_lost(frame: &Frame, name: &str, image: &LostImage) -> Result<Option
         image: name.to_string(),
         model: frame.k,
         correspondences: c.len(),
-        support,
+        support: place.support,
+        second_place,
         links,
     }))
 }
 
-/// How many of correspondences `c` the pose most of them agree with explains, and those it
-/// leaves (none explained where fewer than [`MIN_SUPPORT`] are there to give one).
-fn best_pose(
-    views: &Views,
-    intrinsics: &Intrinsics,
-    c: &[Correspondence],
-) -> Result<(usize, Vec<Correspondence>)> {
+/// The pose most of some correspondences agree with (none where fewer than [`MIN_SUPPORT`]
+/// are there to give one), how many do, and those it leaves.
+struct Place {
+    pose: Option<Pose>,
+    support: usize,
+    rest: Vec<Correspondence>,
+}
+
+/// The [`Place`] of correspondences `c` (to `views`' points, through `intrinsics`).
+fn best_place(views: &Views, intrinsics: &Intrinsics, c: &[Correspondence]) -> Result<Place> {
     let pose = match c.len() < MIN_SUPPORT {
         true => None,
         false => pnp(views, intrinsics, c)?,
     };
     let Some((rotation, translation)) = pose else {
-        return Ok((0, c.to_vec()));
+        return Ok(Place {
+            pose: None,
+            support: 0,
+            rest: c.to_vec(),
+        });
     };
-    let pose = (&rotation, &translation);
-    let (agree, rest): (Vec<_>, Vec<_>) =
-        (c.iter()).partition(|k| reprojection_error(views, intrinsics, pose, k) <= AGREE_PX);
-    Ok((agree.len(), rest))
+    let (agree, rest): (Vec<_>, Vec<_>) = (c.iter()).partition(|k| {
+        reprojection_error(views, intrinsics, (&rotation, &translation), k) <= AGREE_PX
+    });
+    Ok(Place {
+        pose: Some((rotation, translation)),
+        support: agree.len(),
+        rest,
+    })
+}
+
+/// The camera centre of a world-to-camera pose.
+fn centre_of((rotation, translation): &Pose) -> Vector3<f64> {
+    -(rotation.transpose() * translation)
 }
 
 /// A world-to-camera rotation and translation.
@@ -447,7 +473,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
             last.2.push(matched);
         }
     }
-    let centre = -(rotation.transpose() * translation);
+    let centre = centre_of(&(rotation, translation));
     let moved = (centre - view.centre).norm() / spread;
     let named = |w: usize| [view.name.clone(), views.views[w].name.clone()];
     let judged = pairs.iter().filter(|p| p.1[0] >= PAIR_MIN_CORRESPONDENCES);
@@ -481,7 +507,7 @@ fn place(views: &Views, v: usize, spread: f64) -> Result<Option<ImagePlacement>>
     };
     // A second RANSAC, for the few images it concerns.
     if placement.moves() {
-        placement.elsewhere = best_pose(views, &view.intrinsics, &rest)?.0;
+        placement.elsewhere = best_place(views, &view.intrinsics, &rest)?.support;
     }
     Ok(Some(placement))
 }

@@ -1850,6 +1850,58 @@ fn a_lost_image_whose_matches_name_a_third_place_is_not_placed() {
     assert!(placed(3).is_empty());
 }
 
+/// The wall of [`a_lost_image_whose_matches_name_a_third_place_is_not_placed`], the lost image
+/// with true pairs to images 7-8 and more pairs to images 9-11 with the next copy's look: the
+/// pose most of its matches agree with is one metre off, and its links are those false pairs.
+/// Where an earlier run's ghost had the image there (an orbit's end that sees only an object
+/// both copies show alike, plain 38-5716), that place is refuted and the image is placed at
+/// the second, by its true pairs; a ghost that had it elsewhere refutes nothing.
+#[test]
+fn a_lost_image_placed_first_where_an_earlier_ghost_had_it_is_placed_at_its_other_copy() {
+    let mut rng = Lcg(5);
+    let points = facades(&mut rng, 10);
+    let mut images: Vec<SparseImage> = (0..12)
+        .map(|k| image(k + 1, -3.0 + 0.5 * k as f64, &points, 0.6, &mut rng))
+        .collect();
+    let lost = images.pop().expect("12 images");
+    let model = model(images, &points);
+    let mut evidence = Evidence::default();
+    for a in &model.images[6..8] {
+        add_pair(&mut evidence, a, &lost, matches_of(a, &lost, |id| id));
+    }
+    for a in &model.images[8..] {
+        let next_copy = matches_of(a, &lost, |id| id.wrapping_sub(1000));
+        add_pair(&mut evidence, a, &lost, next_copy);
+    }
+    add_lost(&mut evidence, &lost);
+    // An earlier ghost: the model's images where they are, the lost one `shift` metres along.
+    let ghost_with = |shift: f64| {
+        let mut at = lost.clone();
+        at.image.translation.x -= shift;
+        let mut ghost = model.clone();
+        ghost.images.push(at);
+        let rest = model
+            .images
+            .iter()
+            .map(|im| im.image.name.clone())
+            .collect();
+        join::Glued::new(&ghost, [vec![lost.image.name.clone()], rest])
+    };
+    let placed = |earlier: &[join::Glued]| {
+        let models = std::slice::from_ref(&model);
+        let run = check_run(models, Some(&evidence), &DEFAULT_SETTINGS, earlier).unwrap();
+        let [r] = &run.rejoined[..] else {
+            panic!("one image placed: {:?}", run.rejoined)
+        };
+        (r.second_place, r.links.clone())
+    };
+    let pairs =
+        |of: std::ops::Range<u32>| -> Vec<[String; 2]> { of.map(|a| image_pair(a, 12)).collect() };
+    assert_eq!(placed(&[]), (false, pairs(9..12)));
+    assert_eq!(placed(&[ghost_with(-1.0)]), (false, pairs(9..12)));
+    assert_eq!(placed(&[ghost_with(1.0)]), (true, pairs(7..9)));
+}
+
 /// Lost are the images with a verified pair of enough inliers that no model registered,
 /// whether a prune invalidated their pairs (the selection left them out) or not.
 #[test]

@@ -296,17 +296,23 @@ fn unregistered_line(names: &[String]) -> String {
 /// The line for the images no model registered that their matches place in a clean model
 /// through pairs the database does not offer (`lacked`); none without such a pair.
 fn rejoined_line(rejoined: &[Rejoin], lacked: &[[String; 2]]) -> Option<String> {
-    let placed: Vec<String> = (rejoined.iter())
+    let placed: Vec<&Rejoin> = (rejoined.iter())
         .filter(|r| r.links.iter().any(|p| lacked.contains(p)))
-        .map(|r| r.image.clone())
         .collect();
+    let names: Vec<String> = placed.iter().map(|r| r.image.clone()).collect();
+    let second = match placed.iter().filter(|r| r.second_place).count() {
+        0 => String::new(),
+        n => format!(
+            "; {n} at their matches' second place, an earlier run's ghost had them at the first"
+        ),
+    };
     (!placed.is_empty()).then(|| {
         format!(
             "{} images no model registered are placed by their matches in a clean model: {} \
              (prune --model keeps the {} pairs that place them, which this database does not \
-             offer)",
+             offer{second})",
             placed.len(),
-            listed(&placed),
+            listed(&names),
             lacked.len()
         )
     })
