@@ -101,6 +101,11 @@ pub struct Join {
     /// Stronger placements the check called ghosted (at least one: see the module's doc),
     /// earlier runs' ghosts that put the two models onto each other included.
     pub refuted: usize,
+    /// How far the placement puts the second model's cameras from where the nearest earlier
+    /// run's ghost between the two had them, over that ghost's spread ([`Glued::offset`]);
+    /// within [`MISPLACED_DISTANCE`] it is that ghost again, and refuted. None without such a
+    /// ghost, or where their cameras fix no frame.
+    pub ghost_offset: Option<f64>,
     /// The conflicts of the two models put together, one group each.
     pub counts: Counts,
     /// Their score, as a split's ([`super::settings::score`]).
@@ -233,20 +238,24 @@ impl Glued {
     }
 
     /// Whether `placement` (of `b` in `a`'s frame) puts `b`'s cameras where the ghost had them
-    /// beside `a`'s: within [`MISPLACED_DISTANCE`] of their spread (median), once `a`'s cameras
-    /// are carried onto the ghost's. False where the cameras they share fix no frame.
+    /// beside `a`'s: within [`MISPLACED_DISTANCE`] of its spread ([`Glued::offset`]).
     pub fn repeated_by(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> bool {
+        self.offset(a, b, placement)
+            .is_some_and(|off| off <= MISPLACED_DISTANCE)
+    }
+
+    /// How far `placement` (of `b` in `a`'s frame) puts `b`'s cameras from where the ghost had
+    /// them beside `a`'s, once `a`'s cameras are carried onto the ghost's: the median distance
+    /// over the ghost's spread. None where the cameras they share fix no frame.
+    pub fn offset(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> Option<f64> {
         let (b_here, b_ghost) = self.shared(b.images.iter());
-        let Some(to_ghost) = self
+        let to_ghost = self
             .to_ghost(a.images.iter())
-            .filter(|_| !b_here.is_empty())
-        else {
-            return false;
-        };
+            .filter(|_| !b_here.is_empty())?;
         let off = b_here.iter().zip(&b_ghost).map(|(here, ghost)| {
             (to_ghost.apply(&placement.apply(&here.centre())) - ghost.centre()).norm()
         });
-        median(off) <= MISPLACED_DISTANCE * self.spread()
+        Some(median(off) / self.spread())
     }
 
     /// Whether a pose of `image` with camera centre `centre` in `model`'s frame puts it where
@@ -552,7 +561,10 @@ impl Tested<'_> {
         if linked < MIN_SUPPORT {
             return Ok(Test::Explains);
         }
-        if self.ghosts.iter().any(|g| g.repeated_by(a, b, placement)) {
+        let ghost_offset = (self.ghosts.iter())
+            .filter_map(|g| g.offset(a, b, placement))
+            .reduce(f64::min);
+        if ghost_offset.is_some_and(|off| off <= MISPLACED_DISTANCE) {
             // An earlier ghost's placement again: refuted then, whatever it scores now.
             return Ok(Test::Refuted);
         }
@@ -573,6 +585,7 @@ impl Tested<'_> {
                 placement: Placement::from(placement),
                 support: inliers.len(),
                 refuted: 0,
+                ghost_offset,
                 counts,
                 score,
                 links,

@@ -944,8 +944,8 @@ fn left_apart(joins: &join::Joins, reason: ApartReason) {
 
 /// The same two models after a repair turn whose ghost had put them onto each other (an
 /// earlier run's model, ghosted between images 1-6 and 7-12, the second group elsewhere): that
-/// placement was refuted already, so their one placement without conflict joins them. A ghost
-/// between other groups (each model on both of its sides) refutes nothing of theirs.
+/// placement was refuted already, so their one placement without conflict joins them, and the
+/// report says how far from where that ghost had them. A ghost between other groups (each model on both of its sides) refutes nothing of theirs.
 #[test]
 fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     let (a, b) = two_models(
@@ -973,6 +973,10 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     assert_eq!(joins.len(), 1, "{joins:?}");
     assert_eq!(joins[0].refuted, 1);
     assert!(!joins[0].links.is_empty());
+    // The report says how far from the ghost's placement: the second model moved back from
+    // where the ghost had it (elsewhere), far beyond the refuting distance.
+    let offset = joins[0].ghost_offset.expect("a ghost between the two");
+    assert!(offset > 10.0 * join::MISPLACED_DISTANCE, "{offset}");
     let (p, back) = (&joins[0].placement, back_from_elsewhere());
     assert!((p.scale - back.scale).abs() < 1e-6 * back.scale, "{p:?}");
     let odd = |m: &SparseModel, k| {
@@ -1421,6 +1425,7 @@ fn ghost_of_two(
             },
             support: 0,
             refuted: 1,
+            ghost_offset: None,
             counts: Counts::default(),
             score: 0.0,
             links: Vec::new(),
