@@ -42,16 +42,6 @@ use std::collections::{BTreeMap, BTreeSet};
 /// more than this fraction of the model's spread (median): 5%, the evaluation's tolerance for a
 /// correct camera. The correct models measured move by a fraction of a percent.
 pub const MISPLACED_DISTANCE: f64 = 0.05;
-/// Cameras put within this fraction of an earlier run's ghost's camera spread (median) of where
-/// that ghost had them, once the cameras of its other group are carried onto the ghost's, are
-/// where the ghost had them: its placement again, refuted once already ([`Glued`]). Measured
-/// (docs/check.md): such repeats land 0.0016-0.0067 of the spread away for one image (the plain
-/// design's orbit ends), 0.0025-0.030 for models of 16-19 images, and 0.10 for a 3-image orbit
-/// end joined back beside the other orbit's end by the ghost's glue (plain 38-5901, every link
-/// false); a misplaced image's true place lies 0.22 or more away, true joins of street pieces
-/// 0.3-3.5 (session 28) and of the plain design's orbits about 2. Midway (geometric) between
-/// 0.10 and 0.22: 0.15.
-pub const GHOST_DISTANCE: f64 = 0.15;
 /// A clean placement after the one taken is a third place where it puts the second model's
 /// points farther than this fraction of the first model's spread (median) from where the
 /// taken one does: closer, it is the taken placement again, refitted on other
@@ -113,7 +103,7 @@ pub struct Join {
     pub refuted: usize,
     /// How far the placement puts the second model's cameras from where the nearest earlier
     /// run's ghost between the two had them, over that ghost's spread ([`Glued::offset`]);
-    /// within [`GHOST_DISTANCE`] it is that ghost again, and refuted. None without such a
+    /// within [`MISPLACED_DISTANCE`] it is that ghost again, and refuted. None without such a
     /// ghost, or where their cameras fix no frame.
     pub ghost_offset: Option<f64>,
     /// The conflicts of the two models put together, one group each.
@@ -248,10 +238,10 @@ impl Glued {
     }
 
     /// Whether `placement` (of `b` in `a`'s frame) puts `b`'s cameras where the ghost had them
-    /// beside `a`'s: within [`GHOST_DISTANCE`] of its spread ([`Glued::offset`]).
+    /// beside `a`'s: within [`MISPLACED_DISTANCE`] of its spread ([`Glued::offset`]).
     pub fn repeated_by(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> bool {
         self.offset(a, b, placement)
-            .is_some_and(|off| off <= GHOST_DISTANCE)
+            .is_some_and(|off| off <= MISPLACED_DISTANCE)
     }
 
     /// How far `placement` (of `b` in `a`'s frame) puts `b`'s cameras from where the ghost had
@@ -269,7 +259,7 @@ impl Glued {
     }
 
     /// Whether a pose of `image` with camera centre `centre` in `model`'s frame puts it where
-    /// this ghost had it beside its other group: within [`GHOST_DISTANCE`] of the ghost's
+    /// this ghost had it beside its other group: within [`MISPLACED_DISTANCE`] of the ghost's
     /// spread, once `model`'s cameras of that group are carried onto the ghost's. An image that
     /// sees only an object both copies show alike (an orbit's end) matches the other copy's
     /// images as well as its own neighbours, and its matches' pose can be that ghost's pose of
@@ -284,7 +274,7 @@ impl Glued {
         let (Some(to_ghost), Some(ghost)) = (self.to_ghost(other), self.cameras.get(image)) else {
             return false;
         };
-        (to_ghost.apply(centre) - ghost.centre()).norm() <= GHOST_DISTANCE * self.spread()
+        (to_ghost.apply(centre) - ghost.centre()).norm() <= MISPLACED_DISTANCE * self.spread()
     }
 
     /// The cameras of `images` this ghost has too: as given, and as the ghost had them.
@@ -574,7 +564,7 @@ impl Tested<'_> {
         let ghost_offset = (self.ghosts.iter())
             .filter_map(|g| g.offset(a, b, placement))
             .reduce(f64::min);
-        if ghost_offset.is_some_and(|off| off <= GHOST_DISTANCE) {
+        if ghost_offset.is_some_and(|off| off <= MISPLACED_DISTANCE) {
             // An earlier ghost's placement again: refuted then, whatever it scores now.
             return Ok(Test::Refuted);
         }
