@@ -25,8 +25,8 @@
 //! the strongest clean placement joins (streets whose repair left two correct models, the
 //! ghost's placement no longer the strongest once each copy is a model of its own), unless it
 //! puts them where that ghost had them: the refuted placement again, now under the threshold
-//! because each copy's model holds less unique structure than the ghost did
-//! ([`Glued::repeated_by`]).
+//! because each copy's model holds less unique structure than the ghost did (within
+//! [`MISPLACED_DISTANCE`] by [`Glued::offset`]).
 
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
@@ -237,16 +237,10 @@ impl Glued {
         matches!((self.side(a), self.side(b)), (Some(x), Some(y)) if x != y)
     }
 
-    /// Whether `placement` (of `b` in `a`'s frame) puts `b`'s cameras where the ghost had them
-    /// beside `a`'s: within [`MISPLACED_DISTANCE`] of its spread ([`Glued::offset`]).
-    pub fn repeated_by(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> bool {
-        self.offset(a, b, placement)
-            .is_some_and(|off| off <= MISPLACED_DISTANCE)
-    }
-
     /// How far `placement` (of `b` in `a`'s frame) puts `b`'s cameras from where the ghost had
     /// them beside `a`'s, once `a`'s cameras are carried onto the ghost's: the median distance
-    /// over the ghost's spread. None where the cameras they share fix no frame.
+    /// over the ghost's spread. None where the cameras they share fix no frame. Within
+    /// [`MISPLACED_DISTANCE`] the placement is the ghost's again, and a join refuses it.
     pub fn offset(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> Option<f64> {
         let (b_here, b_ghost) = self.shared(b.images.iter());
         let to_ghost = self

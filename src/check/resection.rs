@@ -345,8 +345,14 @@ pub fn place_lost(
     }
     let camera = (frame.model.cameras.iter()).find(|c| c.camera_id == image.camera_id);
     let intrinsics = Intrinsics::from_camera(camera.unwrap_or(&image.camera));
-    // The best pose, the best of what it leaves (its other copy), and a third.
+    // The best pose, the best of what it leaves (its other copy), and a third; the second
+    // and third RANSACs only where the first could place the image or is refuted.
+    let refuted = |p: &Place| p.pose.is_some_and(|pose| refuted(&centre_of(&pose)));
     let first = best_place(views, &intrinsics, &c)?;
+    let first_refuted = refuted(&first);
+    if !first_refuted && first.support < MIN_SUPPORT {
+        return Ok(None);
+    }
     let second = best_place(views, &intrinsics, &first.rest)?;
     if !one_place(
         best_place(views, &intrinsics, &second.rest)?.support,
@@ -354,8 +360,7 @@ pub fn place_lost(
     ) {
         return Ok(None);
     }
-    let refuted = |p: &Place| p.pose.is_some_and(|pose| refuted(&centre_of(&pose)));
-    let (place, second_place) = match refuted(&first) {
+    let (place, second_place) = match first_refuted {
         false => (first, false),
         true if !refuted(&second) => (second, true),
         true => return Ok(None),
