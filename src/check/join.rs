@@ -112,6 +112,8 @@ pub struct Join {
     pub score: f64,
     /// The pairs that link the models, most agreeing correspondences first.
     pub links: Vec<Link>,
+    /// Every placement tried for the two models, most supported first, this one last.
+    pub tried: Vec<Tried>,
 }
 
 /// Two clean models [`join_models`] tried and left apart, and why: a user who sees a scene
@@ -129,6 +131,40 @@ pub struct Apart {
     /// The score of the placement the reason is about ([`ApartReason::Doubtful`],
     /// [`ApartReason::NothingRefuted`], [`ApartReason::ThirdPlace`]: the one that would join).
     pub score: Option<f64>,
+    /// Every placement tried for the two models, most supported first.
+    pub tried: Vec<Tried>,
+}
+
+/// One placement tried for two models ([`join_models`], [`place_group`]), as the report lists
+/// it: how near it came to an earlier ghost's placement and what the check made of it. Refused
+/// placements are the evidence a tolerance such as [`MISPLACED_DISTANCE`] is measured on
+/// (docs/check.md).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Tried {
+    /// Correspondences that agree with it.
+    pub support: usize,
+    /// Of those, the ones on the pairs it explains; 0 where they lie on one spot.
+    pub linked: usize,
+    /// As [`Join::ghost_offset`].
+    pub ghost_offset: Option<f64>,
+    /// What the check made of it.
+    pub verdict: TriedVerdict,
+    /// Its score, where the two models were put together by it and judged.
+    pub score: Option<f64>,
+}
+
+/// What the check made of a placement it tried ([`Tried`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TriedVerdict {
+    /// It explains fewer than [`MIN_SUPPORT`] correspondences on pairs: no placement.
+    TooFew,
+    /// It puts the models where an earlier run's ghost had them: refuted unjudged.
+    GhostAgain,
+    /// The two models put together by it conflict: refuted.
+    Conflicts,
+    /// The two models put together by it do not conflict.
+    Clean,
 }
 
 /// Why [`join_models`] joins two models by none of their placements.
@@ -456,6 +492,7 @@ fn join_two(
         tolerance,
     };
     let mut taken: Option<(Join, Similarity)> = None;
+    let mut tried = Vec::new();
     // [`PLACEMENTS`] placements tried, and the one after a taken placement: its third place.
     for k in 0..=PLACEMENTS {
         if k == PLACEMENTS && taken.is_none() {
@@ -470,25 +507,30 @@ fn join_two(
         }
         let links = links(&pairs, &correspondences, &inliers);
         let after_taken = taken.is_some();
-        match (tested.test(&placement, links, &inliers)?, &taken) {
+        let (test, this) = tested.test(&placement, links, &inliers)?;
+        tried.push(this);
+        match (test, &taken) {
             (Test::Explains, _) => {}
             (Test::Refuted, _) => refuted += 1,
             (Test::Clean(_), Some((join, at))) => {
                 // A third place the check cannot refute, unless it is the taken one again.
                 if apart(b, &placement, at) > THIRD_PLACE_APART * spread {
-                    return Ok(tested.apart(ApartReason::ThirdPlace, refuted, Some(join.score)));
+                    let score = Some(join.score);
+                    return Ok(tested.apart(ApartReason::ThirdPlace, refuted, score, tried));
                 }
             }
             // No ghost, so nothing weaker is taken after it, yet no better than a split the
             // check would doubt: not taken either.
             (Test::Clean(j), None) if j.score >= accept_below => {
-                return Ok(tested.apart(ApartReason::Doubtful, refuted, Some(j.score)));
+                let score = Some(j.score);
+                return Ok(tested.apart(ApartReason::Doubtful, refuted, score, tried));
             }
             // The strongest clean placement joins the models only after a stronger one
             // conflicted: without that, it may be a ghost the check cannot see (copies that
             // share their surroundings), and nothing tells it from a true one.
             (Test::Clean(j), None) if refuted == 0 => {
-                return Ok(tested.apart(ApartReason::NothingRefuted, refuted, Some(j.score)));
+                let score = Some(j.score);
+                return Ok(tested.apart(ApartReason::NothingRefuted, refuted, score, tried));
             }
             (Test::Clean(join), None) => taken = Some((Join { refuted, ..*join }, placement)),
         }
@@ -499,8 +541,8 @@ fn join_two(
         remaining.retain(|k| !used.contains(k));
     }
     match taken {
-        Some((join, _)) => Ok(Outcome::Joined(join)),
-        None => Ok(tested.apart(ApartReason::NoPlacement, refuted, None)),
+        Some((join, _)) => Ok(Outcome::Joined(Join { tried, ..join })),
+        None => Ok(tested.apart(ApartReason::NoPlacement, refuted, None, tried)),
     }
 }
 
@@ -528,39 +570,54 @@ struct Tested<'a> {
 }
 
 impl Tested<'_> {
-    /// The two models left apart, for `reason`.
-    fn apart(&self, reason: ApartReason, refuted: usize, score: Option<f64>) -> Outcome {
+    /// The two models left apart, for `reason`, after the placements `tried`.
+    fn apart(
+        &self,
+        reason: ApartReason,
+        refuted: usize,
+        score: Option<f64>,
+        tried: Vec<Tried>,
+    ) -> Outcome {
         Outcome::Apart(Apart {
             models: self.models,
             correspondences: self.correspondences.len(),
             refuted,
             reason,
             score,
+            tried,
         })
     }
 
-    /// `placement`, agreed with by the correspondences `inliers` on `links`, tested.
+    /// `placement`, agreed with by the correspondences `inliers` on `links`, tested; with what
+    /// the report lists of it.
     fn test(
         &self,
         placement: &Similarity,
         links: Vec<Link>,
         inliers: &[usize],
-    ) -> anyhow::Result<Test> {
+    ) -> anyhow::Result<(Test, Tried)> {
         let [a, b] = self.pair;
         let linked: usize = if degenerate(self.correspondences, inliers, self.tolerance) {
             0
         } else {
             links.iter().map(|l| l.agreeing).sum()
         };
-        if linked < MIN_SUPPORT {
-            return Ok(Test::Explains);
-        }
         let ghost_offset = (self.ghosts.iter())
             .filter_map(|g| g.offset(a, b, placement))
             .reduce(f64::min);
+        let tried = |verdict, score| Tried {
+            support: inliers.len(),
+            linked,
+            ghost_offset,
+            verdict,
+            score,
+        };
+        if linked < MIN_SUPPORT {
+            return Ok((Test::Explains, tried(TriedVerdict::TooFew, None)));
+        }
         if ghost_offset.is_some_and(|off| off <= MISPLACED_DISTANCE) {
             // An earlier ghost's placement again: refuted then, whatever it scores now.
-            return Ok(Test::Refuted);
+            return Ok((Test::Refuted, tried(TriedVerdict::GhostAgain, None)));
         }
         let (merged, from_b) = put_together(a, b, placement);
         let counts = conflict::count_model(
@@ -572,18 +629,22 @@ impl Tested<'_> {
         let score = score(&counts, false, self.settings);
         // The check's own verdict on the two models put together.
         Ok(match is_ghost(&counts, false, self.settings) {
-            true => Test::Refuted,
-            false => Test::Clean(Box::new(Join {
-                models: self.models,
-                correspondences: self.correspondences.len(),
-                placement: Placement::from(placement),
-                support: inliers.len(),
-                refuted: 0,
-                ghost_offset,
-                counts,
-                score,
-                links,
-            })),
+            true => (Test::Refuted, tried(TriedVerdict::Conflicts, Some(score))),
+            false => (
+                Test::Clean(Box::new(Join {
+                    models: self.models,
+                    correspondences: self.correspondences.len(),
+                    placement: Placement::from(placement),
+                    support: inliers.len(),
+                    refuted: 0,
+                    ghost_offset,
+                    counts,
+                    score,
+                    links,
+                    tried: Vec::new(),
+                })),
+                tried(TriedVerdict::Clean, Some(score)),
+            ),
         })
     }
 }

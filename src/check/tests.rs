@@ -977,6 +977,13 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
     // where the ghost had it (elsewhere), far beyond the refuting distance.
     let offset = joins[0].ghost_offset.expect("a ghost between the two");
     assert!(offset > 10.0 * join::MISPLACED_DISTANCE, "{offset}");
+    // The placement taken is the last one the report lists as tried, with the same offset.
+    let taken = joins[0].tried.last().expect("the placement taken");
+    assert_eq!(taken.verdict, join::TriedVerdict::Clean, "{taken:?}");
+    assert_eq!(
+        (taken.ghost_offset, taken.score, taken.support),
+        (Some(offset), Some(joins[0].score), joins[0].support)
+    );
     let (p, back) = (&joins[0].placement, back_from_elsewhere());
     assert!((p.scale - back.scale).abs() < 1e-6 * back.scale, "{p:?}");
     let odd = |m: &SparseModel, k| {
@@ -1007,8 +1014,13 @@ fn two_models_are_not_joined_where_an_earlier_ghost_had_them() {
     let pair = [(&a, false), (&b, false)];
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[glued]).unwrap();
     left_apart(&joins, ApartReason::NoPlacement);
-    // The earlier ghost, and its placement proposed again.
+    // The earlier ghost, and its placement proposed again: listed as tried, unjudged, at
+    // (next to) no offset from where the ghost had it.
     assert_eq!(joins.apart[0].refuted, 2);
+    let again = &joins.apart[0].tried[0];
+    assert_eq!(again.verdict, join::TriedVerdict::GhostAgain, "{again:?}");
+    assert!(again.ghost_offset.unwrap() < 1e-6, "{again:?}");
+    assert_eq!(again.score, None);
 }
 
 /// The ghosted model's two walls as two models: their matches (on the shared object) place
@@ -1429,6 +1441,7 @@ fn ghost_of_two(
             counts: Counts::default(),
             score: 0.0,
             links: Vec::new(),
+            tried: Vec::new(),
         }),
         misplaced_images: images,
         ghost_of_images: of_images,

@@ -700,6 +700,7 @@ mod tests {
             refuted: 1,
             reason,
             score,
+            tried: Vec::new(),
         };
         let line = apart_line(&dirs, &apart(ApartReason::ThirdPlace, Some(0.12)));
         assert!(line.starts_with("sparse/0 + sparse/1: apart (their matches place"));
