@@ -8,7 +8,10 @@ folds one copy onto the other loses one side's).
 usage: scripts/lab/join-truth.py REPORT GROUND_TRUTH [VGSEL]
   REPORT        a `check --report` JSON (with --database_path, so that it has joins)
   GROUND_TRUTH  a text model of the truth (e.g. a rendered scene's gt/, lab-measure's truth_txt)
-Prints one line per join: the models, each alone (correct/registered) and joined."""
+Prints one line per join: the models, each alone (correct/registered) and joined; then one
+line per placement the report lists as tried (`tried`, since session 60), joined or left apart:
+its verdict, `ghost_offset`, score and support, and whether it is true (the two models put
+together by it keep both models' correct cameras)."""
 import json, os, subprocess, sys, tempfile
 
 import numpy as np
@@ -68,7 +71,8 @@ def main():
     vgsel = sys.argv[3] if len(sys.argv) > 3 else "target/release/vgsel-colmap"
     score = lambda m: json.loads(subprocess.run([vgsel, "eval", "--model", m, "--ground_truth", truth],
                                                 capture_output=True, check=True).stdout)
-    for j in json.load(open(report)).get("joins", []):
+    r = json.load(open(report))
+    for j in r.get("joins", []):
         a, b = j["model_paths"]
         ta, tb, tj = tempfile.mkdtemp(), tempfile.mkdtemp(), tempfile.mkdtemp()
         text_model(a, ta)
@@ -79,6 +83,25 @@ def main():
               f" -> {ej['correct']}/{ej['registered']} joined; score {j['score']:.2f}, "
               f"{j['counts']['conflicting']} of {j['counts']['conflicting'] + j['counts']['agreeing']} judged, "
               f"{len(j['links'])} links")
+    # Every placement tried (reports since session 60), joined or left apart: true where the
+    # two models put together by it keep both models' correct cameras.
+    for kind, entries in (("joined", r.get("joins", [])), ("apart", r.get("apart", []))):
+        for j in entries:
+            a, b = j["model_paths"]
+            ta, tb = tempfile.mkdtemp(), tempfile.mkdtemp()
+            text_model(a, ta)
+            text_model(b, tb)
+            ea, eb = score(ta), score(tb)
+            for k, t in enumerate(j.get("tried", [])):
+                tj = tempfile.mkdtemp()
+                joined(ta, tb, t["placement"], tj)
+                ej = score(tj)
+                true = ej["correct"] == ea["correct"] + eb["correct"]
+                offset = "-" if t["ghost_offset"] is None else f"{t['ghost_offset']:.4f}"
+                sc = "-" if t["score"] is None else f"{t['score']:.2f}"
+                print(f"tried {kind} {a} + {b} #{k}: {t['verdict']} offset {offset} score {sc} "
+                      f"support {t['support']} linked {t['linked']} -> {ej['correct']} of "
+                      f"{ea['correct']}+{eb['correct']} correct: {'true' if true else 'false'}")
 
 
 main()

@@ -141,6 +141,8 @@ pub struct Apart {
 /// (docs/check.md).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Tried {
+    /// The placement, as [`Join::placement`].
+    pub placement: Placement,
     /// Correspondences that agree with it.
     pub support: usize,
     /// Of those, the ones on the pairs it explains; 0 where they lie on one spot.
@@ -606,6 +608,7 @@ impl Tested<'_> {
             .filter_map(|g| g.offset(a, b, placement))
             .reduce(f64::min);
         let tried = |verdict, score| Tried {
+            placement: Placement::from(placement),
             support: inliers.len(),
             linked,
             ghost_offset,

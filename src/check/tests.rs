@@ -984,6 +984,7 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
         (taken.ghost_offset, taken.score, taken.support),
         (Some(offset), Some(joins[0].score), joins[0].support)
     );
+    assert_eq!(taken.placement, joins[0].placement);
     let (p, back) = (&joins[0].placement, back_from_elsewhere());
     assert!((p.scale - back.scale).abs() < 1e-6 * back.scale, "{p:?}");
     let odd = |m: &SparseModel, k| {
