@@ -28,9 +28,12 @@ of its own). With --before BINARY (the check before a change), each model is che
 only the rows whose exit status or scores moved are printed, then the counts by truth, exit
 status before and after.
 
+With --keep_reports DIR each report VGSEL wrote is kept there, named by its model folder
+(`scripts/lab/join-truth.py` scores the placements it tried).
+
 usage: VGSEL=target/release/vgsel-colmap scripts/lab/recheck.py [--before BINARY]
        [--loops DIR ...] [--pipelines DIR ... [--as_looped]] [--scenes DIR ...]
-       [--peers WORK ...]
+       [--peers WORK ...] [--keep_reports DIR]
 """
 import argparse
 import collections
@@ -38,6 +41,7 @@ import glob
 import importlib.util
 import json
 import os
+import shutil
 import subprocess
 import tempfile
 
@@ -163,7 +167,12 @@ def main():
                         help="check each repair turn's run after the runs it took as evidence")
     parser.add_argument("--scenes", nargs="*", default=[])
     parser.add_argument("--peers", nargs="*", default=[])
+    parser.add_argument("--keep_reports", metavar="DIR",
+                        help="keep each report (VGSEL's) in DIR, named by its model folder, "
+                             "for scripts/lab/join-truth.py")
     args = parser.parse_args()
+    if args.keep_reports:
+        os.makedirs(args.keep_reports, exist_ok=True)
     verdicts = collections.Counter()
     unanchored = collections.Counter()
     splits = []
@@ -171,6 +180,9 @@ def main():
         report = os.path.join(tmp, "check.json")
         for kind, truth, model, db, earlier in models(args):
             status, lines, after = check(VGSEL, model, db, report, earlier)
+            if args.keep_reports and after:
+                kept = os.path.abspath(model).strip("/").replace("/", "_") + ".json"
+                shutil.copy(report, os.path.join(args.keep_reports, kept))
             split = group_split(after)
             if split:
                 splits.append((truth, *split))

@@ -26,7 +26,7 @@
 //! ghost's placement no longer the strongest once each copy is a model of its own), unless it
 //! puts them where that ghost had them: the refuted placement again, now under the threshold
 //! because each copy's model holds less unique structure than the ghost did (within
-//! [`MISPLACED_DISTANCE`] by [`Glued::offset`]).
+//! [`GHOST_AGAIN`] by [`Glued::offset`]).
 
 use super::conflict::{self, Counts};
 use super::evidence::Evidence;
@@ -49,6 +49,17 @@ pub const MISPLACED_DISTANCE: f64 = 0.05;
 /// placed twice 0.053 apart (both placements' links true); streets' pieces a building on,
 /// 0.12 to 0.95 (docs/check.md, "A join with a third place").
 pub const THIRD_PLACE_APART: f64 = 0.1;
+/// A placement that puts the second model's cameras within this fraction of an earlier run's
+/// ghost's camera spread (median) of where that ghost had them, once the first model's cameras
+/// are carried onto the ghost's, is that ghost's placement again, refitted on other
+/// correspondences: refuted once already ([`Glued::offset`]). Measured on every placement tried
+/// in session 60's loops (docs/check.md): the ghost's placement again 0.0028-0.115, every one
+/// false (0.099: a 3-image orbit end joined back beside the other orbit's end by false pairs
+/// alone, plain 38-5901); the true ones 1.87 or more (plain and adjacent designs), street
+/// pieces' true joins from 0.3 (session 28). Midway (geometric) between 0.115 and 0.3. Wider
+/// than one image's tolerance ([`Glued::places_again`], [`MISPLACED_DISTANCE`]): a model
+/// refitted from another run's points scatters more than one camera placed by its matches.
+pub const GHOST_AGAIN: f64 = 0.2;
 /// Placements tried per pair of models, most supported first.
 pub const PLACEMENTS: usize = 3;
 /// Random minimal samples (three correspondences) drawn per placement.
@@ -103,7 +114,7 @@ pub struct Join {
     pub refuted: usize,
     /// How far the placement puts the second model's cameras from where the nearest earlier
     /// run's ghost between the two had them, over that ghost's spread ([`Glued::offset`]);
-    /// within [`MISPLACED_DISTANCE`] it is that ghost again, and refuted. None without such a
+    /// within [`GHOST_AGAIN`] it is that ghost again, and refuted. None without such a
     /// ghost, or where their cameras fix no frame.
     pub ghost_offset: Option<f64>,
     /// The conflicts of the two models put together, one group each.
@@ -137,7 +148,7 @@ pub struct Apart {
 
 /// One placement tried for two models ([`join_models`], [`place_group`]), as the report lists
 /// it: how near it came to an earlier ghost's placement and what the check made of it. Refused
-/// placements are the evidence a tolerance such as [`MISPLACED_DISTANCE`] is measured on
+/// placements are the evidence a tolerance such as [`GHOST_AGAIN`] is measured on
 /// (docs/check.md).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Tried {
@@ -145,7 +156,8 @@ pub struct Tried {
     pub placement: Placement,
     /// Correspondences that agree with it.
     pub support: usize,
-    /// Of those, the ones on the pairs it explains; 0 where they lie on one spot.
+    /// Of those, the ones on the pairs it explains ([`PAIR_MIN_AGREEING`],
+    /// [`PAIR_MIN_FRACTION`]).
     pub linked: usize,
     /// As [`Join::ghost_offset`].
     pub ghost_offset: Option<f64>,
@@ -159,6 +171,9 @@ pub struct Tried {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TriedVerdict {
+    /// Its correspondences lie on one spot of the first model ([`DEGENERATE_EXTENT`]): it may
+    /// shrink the second model onto that spot, so it places nothing.
+    OneSpot,
     /// It explains fewer than [`MIN_SUPPORT`] correspondences on pairs: no placement.
     TooFew,
     /// It puts the models where an earlier run's ghost had them: refuted unjudged.
@@ -278,7 +293,7 @@ impl Glued {
     /// How far `placement` (of `b` in `a`'s frame) puts `b`'s cameras from where the ghost had
     /// them beside `a`'s, once `a`'s cameras are carried onto the ghost's: the median distance
     /// over the ghost's spread. None where the cameras they share fix no frame. Within
-    /// [`MISPLACED_DISTANCE`] the placement is the ghost's again, and a join refuses it.
+    /// [`GHOST_AGAIN`] the placement is the ghost's again, and a join refuses it.
     pub fn offset(&self, a: &SparseModel, b: &SparseModel, placement: &Similarity) -> Option<f64> {
         let (b_here, b_ghost) = self.shared(b.images.iter());
         let to_ghost = self
@@ -599,11 +614,8 @@ impl Tested<'_> {
         inliers: &[usize],
     ) -> anyhow::Result<(Test, Tried)> {
         let [a, b] = self.pair;
-        let linked: usize = if degenerate(self.correspondences, inliers, self.tolerance) {
-            0
-        } else {
-            links.iter().map(|l| l.agreeing).sum()
-        };
+        let one_spot = degenerate(self.correspondences, inliers, self.tolerance);
+        let linked: usize = links.iter().map(|l| l.agreeing).sum();
         let ghost_offset = (self.ghosts.iter())
             .filter_map(|g| g.offset(a, b, placement))
             .reduce(f64::min);
@@ -615,10 +627,13 @@ impl Tested<'_> {
             verdict,
             score,
         };
+        if one_spot {
+            return Ok((Test::Explains, tried(TriedVerdict::OneSpot, None)));
+        }
         if linked < MIN_SUPPORT {
             return Ok((Test::Explains, tried(TriedVerdict::TooFew, None)));
         }
-        if ghost_offset.is_some_and(|off| off <= MISPLACED_DISTANCE) {
+        if ghost_offset.is_some_and(|off| off <= GHOST_AGAIN) {
             // An earlier ghost's placement again: refuted then, whatever it scores now.
             return Ok((Test::Refuted, tried(TriedVerdict::GhostAgain, None)));
         }
