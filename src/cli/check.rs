@@ -363,9 +363,10 @@ fn apart_line(dirs: &[PathBuf], a: &check::join::Apart) -> String {
     let score = a.score.map_or_else(String::new, |s| format!("{s:.2}"));
     let why = match a.reason {
         ApartReason::NoPlacement => format!(
-            "every placement their {} correspondences give conflicts or explains too few of \
-             their pairs; {} refuted",
-            a.correspondences, a.refuted
+            "no placement of their {} correspondences joins them{}; {} refuted",
+            a.correspondences,
+            tried_counts(&a.tried),
+            a.refuted
         ),
         ApartReason::NothingRefuted => format!(
             "their strongest placement does not conflict, score {score}, but nothing \
@@ -385,6 +386,28 @@ fn apart_line(dirs: &[PathBuf], a: &check::join::Apart) -> String {
         dirs[a.models[0]].display(),
         dirs[a.models[1]].display()
     )
+}
+
+/// What became of the placements `tried` for two models left apart, by verdict (", 1 where an
+/// earlier run's ghost had them, 2 explaining too few of their pairs"); empty without any.
+fn tried_counts(tried: &[check::join::Tried]) -> String {
+    use check::join::TriedVerdict::*;
+    let said = [
+        (Conflicts, "conflicting"),
+        (GhostAgain, "where an earlier run's ghost had them"),
+        (TooFew, "explaining too few of their pairs"),
+        (OneSpot, "on one spot"),
+        (Clean, "clean"),
+    ];
+    let parts: Vec<String> = (said.iter())
+        .map(|(v, what)| (tried.iter().filter(|t| t.verdict == *v).count(), what))
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| format!("{n} {what}"))
+        .collect();
+    match parts.is_empty() {
+        true => String::new(),
+        false => format!(": {}", parts.join(", ")),
+    }
 }
 
 /// `item`'s JSON with the folders of its two `models` (indices of `dirs`) as `model_paths`.
@@ -707,10 +730,35 @@ mod tests {
         assert!(line.contains("two places the check cannot tell apart, the first scoring 0.12"));
         let line = apart_line(&dirs, &apart(ApartReason::NoPlacement, None));
         assert!(
-            line.contains("their 400 correspondences give conflicts"),
+            line.contains("no placement of their 400 correspondences joins them; 1 refuted)"),
             "{line}"
         );
-        assert!(line.ends_with("1 refuted)"), "{line}");
+        // The placements tried, counted by what became of them.
+        let tried = |verdict| check::join::Tried {
+            placement: check::join::Placement {
+                scale: 1.0,
+                rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                translation: [0.0; 3],
+            },
+            support: 40,
+            linked: 0,
+            ghost_offset: None,
+            verdict,
+            score: None,
+        };
+        use check::join::TriedVerdict::{GhostAgain, TooFew};
+        let three = Apart {
+            tried: vec![tried(GhostAgain), tried(TooFew), tried(TooFew)],
+            ..apart(ApartReason::NoPlacement, None)
+        };
+        let line = apart_line(&dirs, &three);
+        assert!(
+            line.contains(
+                "joins them: 1 where an earlier run's ghost had them, 2 explaining too few of \
+                 their pairs; 1 refuted)"
+            ),
+            "{line}"
+        );
         let line = apart_line(&dirs, &apart(ApartReason::Doubtful, Some(0.45)));
         assert!(line.contains("scores 0.45, too near a ghost's"), "{line}");
         let line = apart_line(&dirs, &apart(ApartReason::NothingRefuted, Some(0.02)));
