@@ -29,7 +29,7 @@
 //! [`GHOST_AGAIN`] by [`Glued::offset`]).
 
 use super::conflict::{self, Counts};
-use super::evidence::Evidence;
+use super::evidence::{in_name_order, Evidence};
 use super::settings::{is_ghost, score, CheckSettings};
 use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
@@ -94,6 +94,12 @@ pub struct Link {
     pub correspondences: usize,
     /// Of those, the ones that agree with the placement.
     pub agreeing: usize,
+    /// For a trimmed link (kept with only its agreeing matches, where the placement explains
+    /// no whole pair after an earlier ghost: [`join_models`]): the pair's other matches
+    /// (keypoints in name order), which `prune --model` drops so that the pair is kept with
+    /// those alone (in the report's `repair.dropped`). Empty for a link kept whole.
+    #[serde(skip)]
+    pub dropped: Vec<[u32; 2]>,
 }
 
 /// Two models joined by a placement that does not conflict.
@@ -163,6 +169,9 @@ pub struct Tried {
     pub ghost_offset: Option<f64>,
     /// What the check made of it.
     pub verdict: TriedVerdict,
+    /// Judged with trimmed links ([`Link::dropped`]), after no placement joined the two with
+    /// whole pairs.
+    pub trimmed: bool,
     /// Its score, where the two models were put together by it and judged.
     pub score: Option<f64>,
 }
@@ -359,8 +368,9 @@ fn camera_points(cameras: &[ModelImage]) -> Vec<Vector3<f64>> {
     centres.iter().copied().chain(ahead).collect()
 }
 
-/// One correspondence: the second model's point, the first's, and the database pair it is from.
-type Correspondence = (Vector3<f64>, Vector3<f64>, usize);
+/// One correspondence: the second model's point, the first's, the database pair it is from, and
+/// its match (keypoints in the pair's name order, as [`Evidence::matches`] holds them).
+type Correspondence = (Vector3<f64>, Vector3<f64>, usize, [u32; 2]);
 
 /// The joins among `models` (each with its check's verdict: ghosted models are not joined),
 /// and the pairs left apart. Each pair of clean models with at least `min_group` images each
@@ -484,6 +494,11 @@ pub(super) fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
 /// such a next placement (all streets) had 8 links true of 107; every other's next placement
 /// explained no pair, conflicted, or was the same place (the halls', the duplicates' and the
 /// streets' right joins: docs/check.md, "A join with a third place").
+///
+/// Where no placement joins them and an earlier run's ghost lies between the two, the
+/// placements that explained too few whole pairs are judged again, strongest first, with
+/// [`trimmed_links`]: the first that does not conflict and scores under `accept_below` joins
+/// them, its pairs kept with only their agreeing matches.
 fn join_two(
     models: [usize; 2],
     [a, b]: [&SparseModel; 2],
@@ -510,6 +525,8 @@ fn join_two(
     };
     let mut taken: Option<(Join, Similarity)> = None;
     let mut tried = Vec::new();
+    // The placements that explained too few whole pairs, for the trimmed links.
+    let mut too_few: Vec<(Similarity, Vec<usize>)> = Vec::new();
     // [`PLACEMENTS`] placements tried, and the one after a taken placement: its third place.
     for k in 0..=PLACEMENTS {
         if k == PLACEMENTS && taken.is_none() {
@@ -525,6 +542,9 @@ fn join_two(
         let links = links(&pairs, &correspondences, &inliers);
         let after_taken = taken.is_some();
         let (test, this) = tested.test(&placement, links, &inliers)?;
+        if this.verdict == TriedVerdict::TooFew {
+            too_few.push((placement.clone(), inliers.clone()));
+        }
         tried.push(this);
         match (test, &taken) {
             (Test::Explains, _) => {}
@@ -557,10 +577,29 @@ fn join_two(
         let used: BTreeSet<usize> = inliers.into_iter().collect();
         remaining.retain(|k| !used.contains(k));
     }
-    match taken {
-        Some((join, _)) => Ok(Outcome::Joined(Join { tried, ..join })),
-        None => Ok(tested.apart(ApartReason::NoPlacement, refuted, None, tried)),
+    if let Some((join, _)) = taken {
+        return Ok(Outcome::Joined(Join { tried, ..join }));
     }
+    for (placement, inliers) in too_few.iter().filter(|_| !ghosts.is_empty()) {
+        let links = trimmed_links(&pairs, &correspondences, inliers, evidence);
+        let (test, this) = tested.test(placement, links, inliers)?;
+        tried.push(Tried {
+            trimmed: true,
+            ..this
+        });
+        match test {
+            Test::Refuted => refuted += 1,
+            Test::Clean(join) if join.score < accept_below => {
+                return Ok(Outcome::Joined(Join {
+                    refuted,
+                    tried,
+                    ..*join
+                }));
+            }
+            Test::Explains | Test::Clean(_) => {}
+        }
+    }
+    Ok(tested.apart(ApartReason::NoPlacement, refuted, None, tried))
 }
 
 /// What the check makes of one placement of [`join_two`].
@@ -626,6 +665,7 @@ impl Tested<'_> {
             ghost_offset,
             verdict,
             score,
+            trimmed: false,
         };
         if one_spot {
             return Ok((Test::Explains, tried(TriedVerdict::OneSpot, None)));
@@ -696,7 +736,7 @@ fn correspondences(
             for m in matches {
                 let (ka, kb) = if swapped { (m[1], m[0]) } else { (m[0], m[1]) };
                 if let (Some(xa), Some(xb)) = (point_of(a, ia, ka), point_of(b, ib, kb)) {
-                    out.push((xb, xa, pair));
+                    out.push((xb, xa, pair, *m));
                 }
             }
         }
@@ -892,13 +932,57 @@ fn links(pairs: &[[String; 2]], c: &[Correspondence], inliers: &[usize]) -> Vec<
             image2: pairs[p][1].clone(),
             correspondences: total[&p],
             agreeing: n,
+            dropped: Vec::new(),
         })
         .collect();
-    out.sort_by(|x, y| {
+    by_agreeing(&mut out);
+    out
+}
+
+/// Links most agreeing correspondences first, then by name.
+fn by_agreeing(links: &mut [Link]) {
+    links.sort_by(|x, y| {
         y.agreeing
             .cmp(&x.agreeing)
             .then((&x.image1, &x.image2).cmp(&(&y.image1, &y.image2)))
     });
+}
+
+/// The pairs that hold at least [`PAIR_MIN_AGREEING`] correspondences agreeing with a
+/// placement, whatever share of theirs that is, each kept with only those matches: the links
+/// of two orbits whose true placement explains no whole pair, because every pair that holds its
+/// correspondences holds more of the ghost's (plain 38-6014: 5-39 agreeing of 96-317 matches;
+/// trimmed so, the mapper makes one correct model with every mapper tried: docs/check.md).
+fn trimmed_links(
+    pairs: &[[String; 2]],
+    c: &[Correspondence],
+    inliers: &[usize],
+    evidence: &Evidence,
+) -> Vec<Link> {
+    let mut total: BTreeMap<usize, usize> = BTreeMap::new();
+    c.iter().for_each(|x| *total.entry(x.2).or_default() += 1);
+    let mut kept: BTreeMap<usize, BTreeSet<[u32; 2]>> = BTreeMap::new();
+    for &k in inliers {
+        kept.entry(c[k].2).or_default().insert(c[k].3);
+    }
+    let mut out: Vec<Link> = (kept.into_iter())
+        .filter(|(_, m)| m.len() >= PAIR_MIN_AGREEING)
+        .map(|(p, m)| {
+            let key = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
+            let all = evidence.matches.get(&(key[0].clone(), key[1].clone()));
+            Link {
+                image1: pairs[p][0].clone(),
+                image2: pairs[p][1].clone(),
+                correspondences: total[&p],
+                agreeing: m.len(),
+                dropped: (all.into_iter().flatten())
+                    .filter(|x| !m.contains(*x))
+                    .copied()
+                    .collect(),
+            }
+        })
+        .collect();
+    by_agreeing(&mut out);
     out
 }
 
@@ -915,6 +999,7 @@ mod tests {
                 Vector3::new(x, 0.0, 0.0),
                 Vector3::new(0.001 * x, 0.0, 0.0),
                 0,
+                [0, 0],
             )
         };
         let c: Vec<Correspondence> = (0..50).map(|k| at(f64::from(k))).collect();

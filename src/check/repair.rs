@@ -25,8 +25,9 @@ pub struct ModelEvidence {
     /// ([`join::place_group`]): what the mapper needs to place them right. Sorted.
     pub links: Vec<[String; 2]>,
     /// The matches that hold the misplaced images where the model put them
-    /// ([`resection::ImagePlacement::holding`]), per pair in name order: `prune --model` drops
-    /// them from the pairs it keeps. Sorted.
+    /// ([`resection::ImagePlacement::holding`]), and those of a trimmed link against its
+    /// placement ([`join::Link::dropped`]), per pair in name order: `prune --model` drops them
+    /// from the pairs it keeps. Sorted.
     pub dropped: Vec<resection::PairMatches>,
     /// The pairs that place an image no model registered in a clean model
     /// ([`resection::Rejoin`]): kept unless a ghost of any run blamed them. Sorted.
@@ -101,7 +102,11 @@ impl RunCheck<'_> {
             .chain(placed)
             .flat_map(|j| &j.links)
         {
-            links.insert(in_name_order(l.image1.clone(), l.image2.clone()));
+            let key = in_name_order(l.image1.clone(), l.image2.clone());
+            if !l.dropped.is_empty() {
+                dropped.entry(key.clone()).or_default().extend(&l.dropped);
+            }
+            links.insert(key);
         }
         let rejoin = (self.rejoined.iter())
             .flat_map(|r| r.links.iter().cloned())

@@ -1050,6 +1050,73 @@ fn two_models_placed_near_where_an_earlier_ghost_had_them_are_not_joined() {
     assert!(joined(0.30));
 }
 
+/// The same two models after an earlier ghost put them onto each other, where every pair holds
+/// twice as many false matches (each true match's keypoint matched to two other points' too)
+/// as true ones: their true placement is the strongest but explains no whole pair. It joins
+/// them only with trimmed links, each pair kept with just its agreeing matches, the rest for
+/// the repair to drop (plain 38-6014: 5-39 agreeing of 96-317; docs/check.md).
+#[test]
+fn two_models_whose_true_placement_explains_no_whole_pair_are_joined_by_trimmed_links() {
+    let (a, b) = two_models(
+        &correct_model(),
+        |im| im.image.image_id > 6,
+        100_000,
+        &elsewhere(),
+    );
+    let mut evidence = matches_between(&a, &b, 100_000);
+    for m in evidence.matches.values_mut().filter(|m| !m.is_empty()) {
+        let n = m.len();
+        let false_ones: Vec<[u32; 2]> = (1..=2)
+            .flat_map(|s| (0..n).map(move |k| (k, (k + s) % n)))
+            .map(|(k, j)| [m[k][0], m[j][1]])
+            .collect();
+        m.extend(false_ones);
+    }
+    let names = |m: &SparseModel| m.images.iter().map(|im| im.image.name.clone()).collect();
+    let ghost = SparseModel {
+        images: [a.images.clone(), b.images.clone()].concat(),
+        ..SparseModel::default()
+    };
+    let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
+    let pair = [(&a, false), (&b, false)];
+    let earlier = std::slice::from_ref(&glued);
+    let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, earlier).unwrap();
+    assert_eq!(joins.joined.len(), 1, "{joins:?}");
+    let join = &joins.joined[0];
+    // The repair keeps the linking pairs and drops their other matches.
+    let models = [a.clone(), b.clone()];
+    let run = check_run(&models, Some(&evidence), &DEFAULT_SETTINGS, earlier).unwrap();
+    let repair = run.evidence();
+    assert_eq!(repair.links.len(), join.links.len());
+    let dropped: usize = repair.dropped.iter().map(|d| d.matches.len()).sum();
+    let expected: usize = join.links.iter().map(|l| l.dropped.len()).sum();
+    assert_eq!(
+        (dropped, repair.dropped.len()),
+        (expected, join.links.len())
+    );
+    let first = &join.tried[0];
+    assert_eq!(
+        (first.verdict, first.trimmed, first.linked),
+        (join::TriedVerdict::TooFew, false, 0),
+        "{first:?}"
+    );
+    let taken = join.tried.last().unwrap();
+    assert!(taken.trimmed && taken.verdict == join::TriedVerdict::Clean);
+    assert!(!join.links.is_empty());
+    for link in &join.links {
+        let key = (link.image1.clone(), link.image2.clone());
+        let key = if key.0 < key.1 { key } else { (key.1, key.0) };
+        let all = &evidence.matches[&key];
+        // The agreeing matches stay, the false ones go.
+        assert_eq!(link.agreeing * 3, all.len(), "{link:?}");
+        assert_eq!(link.dropped.len(), 2 * link.agreeing, "{link:?}");
+        assert!(link.dropped.iter().all(|d| all.contains(d)));
+    }
+    // Without an earlier ghost between them nothing was refuted: apart, as whole pairs.
+    let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[]).unwrap();
+    assert!(joins.joined.is_empty(), "{joins:?}");
+}
+
 /// The ghosted model's two walls as two models: their matches (on the shared object) place
 /// one wall's cameras onto the other's, which conflicts, and nothing else places them.
 #[test]

@@ -352,7 +352,20 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
         bare(&j.counts),
         j.links.len(),
         examples(j.links.iter().map(|l| (&l.image1, &l.image2)))
-    )
+    ) + &trimmed_text(&j.links)
+}
+
+/// For links kept with only their agreeing matches ([`check::join::Link::dropped`]): how many
+/// matches stay and how many the repair drops.
+fn trimmed_text(links: &[check::join::Link]) -> String {
+    let dropped: usize = links.iter().map(|l| l.dropped.len()).sum();
+    match dropped {
+        0 => String::new(),
+        _ => format!(
+            ", kept with only their {} agreeing matches ({dropped} others dropped)",
+            links.iter().map(|l| l.agreeing).sum::<usize>()
+        ),
+    }
 }
 
 /// The line for two clean models left apart that share enough correspondences to be placed:
@@ -745,6 +758,7 @@ mod tests {
             ghost_offset: None,
             verdict,
             score: None,
+            trimmed: false,
         };
         use check::join::TriedVerdict::{GhostAgain, TooFew};
         let three = Apart {
