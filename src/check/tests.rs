@@ -942,12 +942,10 @@ fn left_apart(joins: &join::Joins, reason: ApartReason) {
     assert_eq!(apart.score.is_some(), about_one, "{apart:?}");
 }
 
-/// The same two models after a repair turn whose ghost had put them onto each other (an
-/// earlier run's model, ghosted between images 1-6 and 7-12, the second group elsewhere): that
-/// placement was refuted already, so their one placement without conflict joins them, and the
-/// report says how far from where that ghost had them. A ghost between other groups (each model on both of its sides) refutes nothing of theirs.
-#[test]
-fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
+/// The correct wall as two models (images 1-6, and 7-12 elsewhere), their matches, and an
+/// earlier run's ghost that had put them onto each other (its groups the two models', the
+/// second elsewhere as now).
+fn two_models_an_earlier_ghost_glued() -> (SparseModel, SparseModel, Evidence, join::Glued) {
     let (a, b) = two_models(
         &correct_model(),
         |im| im.image.image_id > 6,
@@ -961,6 +959,16 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
         ..SparseModel::default()
     };
     let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
+    (a, b, evidence, glued)
+}
+
+/// The same two models after a repair turn whose ghost had put them onto each other (an
+/// earlier run's model, ghosted between images 1-6 and 7-12, the second group elsewhere): that
+/// placement was refuted already, so their one placement without conflict joins them, and the
+/// report says how far from where that ghost had them. A ghost between other groups (each model on both of its sides) refutes nothing of theirs.
+#[test]
+fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
+    let (a, b, evidence, glued) = two_models_an_earlier_ghost_glued();
     let pair = [(&a, false), (&b, false)];
     let strict = no_placement_taken();
     let passed_over =
@@ -995,6 +1003,10 @@ fn two_models_an_earlier_ghost_put_onto_each_other_are_joined() {
         [odd(&a, 0), odd(&b, 0)].concat(),
         [odd(&a, 1), odd(&b, 1)].concat(),
     ];
+    let ghost = SparseModel {
+        images: [a.images.clone(), b.images.clone()].concat(),
+        ..SparseModel::default()
+    };
     let across = join::Glued::new(&ghost, across);
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[across]).unwrap();
     left_apart(&joins, ApartReason::NothingRefuted);
@@ -1057,13 +1069,7 @@ fn two_models_placed_near_where_an_earlier_ghost_had_them_are_not_joined() {
 /// the repair to drop (plain 38-6014: 5-39 agreeing of 96-317; docs/check.md).
 #[test]
 fn two_models_whose_true_placement_explains_no_whole_pair_are_joined_by_trimmed_links() {
-    let (a, b) = two_models(
-        &correct_model(),
-        |im| im.image.image_id > 6,
-        100_000,
-        &elsewhere(),
-    );
-    let mut evidence = matches_between(&a, &b, 100_000);
+    let (a, b, mut evidence, glued) = two_models_an_earlier_ghost_glued();
     for m in evidence.matches.values_mut().filter(|m| !m.is_empty()) {
         let n = m.len();
         let false_ones: Vec<[u32; 2]> = (1..=2)
@@ -1072,12 +1078,6 @@ fn two_models_whose_true_placement_explains_no_whole_pair_are_joined_by_trimmed_
             .collect();
         m.extend(false_ones);
     }
-    let names = |m: &SparseModel| m.images.iter().map(|im| im.image.name.clone()).collect();
-    let ghost = SparseModel {
-        images: [a.images.clone(), b.images.clone()].concat(),
-        ..SparseModel::default()
-    };
-    let glued = join::Glued::new(&ghost, [names(&a), names(&b)]);
     let pair = [(&a, false), (&b, false)];
     let earlier = std::slice::from_ref(&glued);
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, earlier).unwrap();
