@@ -511,18 +511,10 @@ fn join_two(
     let mut refuted = refuted + ghosts.len();
     let (pairs, correspondences) = correspondences(a, b, evidence);
     let spread = spread(a);
-    let tolerance = INLIER_DISTANCE * spread;
     let mut remaining: Vec<usize> = (0..correspondences.len()).collect();
     let mut rng = SplitMix(0);
-    let tested = Tested {
-        models,
-        pair: [a, b],
-        evidence,
-        settings,
-        ghosts,
-        correspondences: &correspondences,
-        tolerance,
-    };
+    let tested = Tested::new(models, [a, b], evidence, settings, ghosts, &correspondences);
+    let tolerance = tested.tolerance;
     let mut taken: Option<(Join, Similarity)> = None;
     let mut tried = Vec::new();
     // The placements that explained too few whole pairs, for the trimmed links.
@@ -577,29 +569,10 @@ fn join_two(
         let used: BTreeSet<usize> = inliers.into_iter().collect();
         remaining.retain(|k| !used.contains(k));
     }
-    if let Some((join, _)) = taken {
-        return Ok(Outcome::Joined(Join { tried, ..join }));
+    match taken {
+        Some((join, _)) => Ok(Outcome::Joined(Join { tried, ..join })),
+        None => tested.with_trimmed_links(&pairs, &too_few, refuted, tried, accept_below),
     }
-    for (placement, inliers) in too_few.iter().filter(|_| !ghosts.is_empty()) {
-        let links = trimmed_links(&pairs, &correspondences, inliers, evidence);
-        let (test, this) = tested.test(placement, links, inliers)?;
-        tried.push(Tried {
-            trimmed: true,
-            ..this
-        });
-        match test {
-            Test::Refuted => refuted += 1,
-            Test::Clean(join) if join.score < accept_below => {
-                return Ok(Outcome::Joined(Join {
-                    refuted,
-                    tried,
-                    ..*join
-                }));
-            }
-            Test::Explains | Test::Clean(_) => {}
-        }
-    }
-    Ok(tested.apart(ApartReason::NoPlacement, refuted, None, tried))
 }
 
 /// What the check makes of one placement of [`join_two`].
@@ -625,7 +598,63 @@ struct Tested<'a> {
     tolerance: f64,
 }
 
-impl Tested<'_> {
+impl<'a> Tested<'a> {
+    /// Placements of `pair`'s second model in the first's frame, tested on `correspondences`.
+    fn new(
+        models: [usize; 2],
+        pair: [&'a SparseModel; 2],
+        evidence: &'a Evidence,
+        settings: &'a CheckSettings,
+        ghosts: &'a [&'a Glued],
+        correspondences: &'a [Correspondence],
+    ) -> Self {
+        let tolerance = INLIER_DISTANCE * spread(pair[0]);
+        Tested {
+            models,
+            pair,
+            evidence,
+            settings,
+            ghosts,
+            correspondences,
+            tolerance,
+        }
+    }
+
+    /// The last resort of [`join_two`], where no placement joined the two with whole pairs and
+    /// an earlier ghost lies between them: the placements that explained `too_few` whole pairs
+    /// (on `pairs`), judged with [`trimmed_links`], strongest first; the first clean one that
+    /// scores under `accept_below` joins them. Else apart, after the placements `tried`.
+    fn with_trimmed_links(
+        &self,
+        pairs: &[[String; 2]],
+        too_few: &[(Similarity, Vec<usize>)],
+        mut refuted: usize,
+        mut tried: Vec<Tried>,
+        accept_below: f64,
+    ) -> anyhow::Result<Outcome> {
+        for (placement, inliers) in too_few.iter().filter(|_| !self.ghosts.is_empty()) {
+            let links = trimmed_links(pairs, self.correspondences, inliers, self.evidence);
+            let (test, this) = self.test(placement, links, inliers)?;
+            tried.push(Tried {
+                trimmed: true,
+                ..this
+            });
+            match test {
+                Test::Refuted => refuted += 1,
+                Test::Clean(join) if join.score < accept_below => {
+                    let join = Join {
+                        refuted,
+                        tried,
+                        ..*join
+                    };
+                    return Ok(Outcome::Joined(join));
+                }
+                Test::Explains | Test::Clean(_) => {}
+            }
+        }
+        Ok(self.apart(ApartReason::NoPlacement, refuted, None, tried))
+    }
+
     /// The two models left apart, for `reason`, after the placements `tried`.
     fn apart(
         &self,

@@ -75,16 +75,7 @@ impl RunCheck<'_> {
         // Each pair's matches in name order, merged where both images are misplaced.
         let mut dropped: BTreeMap<[String; 2], BTreeSet<[u32; 2]>> = BTreeMap::new();
         for h in images.clone().flat_map(|m| &m.holding) {
-            let [a, b] = h.images.clone();
-            let (key, swap) = if a < b {
-                ([a, b], false)
-            } else {
-                ([b, a], true)
-            };
-            let matches = h
-                .matches
-                .iter()
-                .map(|&[x, y]| if swap { [y, x] } else { [x, y] });
+            let (key, matches) = name_ordered(h);
             dropped.entry(key).or_default().extend(matches);
         }
         let mut links = BTreeSet::new();
@@ -122,6 +113,15 @@ impl RunCheck<'_> {
                 })
                 .collect(),
         }
+    }
+}
+
+/// A pair's matches with the pair in name order, each match's keypoints swapped to follow.
+fn name_ordered(h: &resection::PairMatches) -> ([String; 2], Vec<[u32; 2]>) {
+    let [a, b] = h.images.clone();
+    match a < b {
+        true => ([a, b], h.matches.clone()),
+        false => ([b, a], h.matches.iter().map(|&[x, y]| [y, x]).collect()),
     }
 }
 
