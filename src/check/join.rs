@@ -510,11 +510,10 @@ fn join_two(
 ) -> anyhow::Result<Outcome> {
     let mut refuted = refuted + ghosts.len();
     let (pairs, correspondences) = correspondences(a, b, evidence);
-    let spread = spread(a);
     let mut remaining: Vec<usize> = (0..correspondences.len()).collect();
     let mut rng = SplitMix(0);
     let tested = Tested::new(models, [a, b], evidence, settings, ghosts, &correspondences);
-    let tolerance = tested.tolerance;
+    let (spread, tolerance) = (tested.spread, tested.tolerance());
     let mut taken: Option<(Join, Similarity)> = None;
     let mut tried = Vec::new();
     // The placements that explained too few whole pairs, for the trimmed links.
@@ -594,8 +593,9 @@ struct Tested<'a> {
     settings: &'a CheckSettings,
     ghosts: &'a [&'a Glued],
     correspondences: &'a [Correspondence],
-    /// The agreement distance of the placements ([`INLIER_DISTANCE`] of the first's spread).
-    tolerance: f64,
+    /// The first model's spread (median distance of its points to their centroid): the scale
+    /// of the agreement distance and of a third place.
+    spread: f64,
 }
 
 impl<'a> Tested<'a> {
@@ -608,7 +608,6 @@ impl<'a> Tested<'a> {
         ghosts: &'a [&'a Glued],
         correspondences: &'a [Correspondence],
     ) -> Self {
-        let tolerance = INLIER_DISTANCE * spread(pair[0]);
         Tested {
             models,
             pair,
@@ -616,8 +615,13 @@ impl<'a> Tested<'a> {
             settings,
             ghosts,
             correspondences,
-            tolerance,
+            spread: spread(pair[0]),
         }
+    }
+
+    /// The agreement distance of the placements: [`INLIER_DISTANCE`] of the first's spread.
+    fn tolerance(&self) -> f64 {
+        INLIER_DISTANCE * self.spread
     }
 
     /// The last resort of [`join_two`], where no placement joined the two with whole pairs and
@@ -682,7 +686,7 @@ impl<'a> Tested<'a> {
         inliers: &[usize],
     ) -> anyhow::Result<(Test, Tried)> {
         let [a, b] = self.pair;
-        let one_spot = degenerate(self.correspondences, inliers, self.tolerance);
+        let one_spot = degenerate(self.correspondences, inliers, self.tolerance());
         let linked: usize = links.iter().map(|l| l.agreeing).sum();
         let ghost_offset = (self.ghosts.iter())
             .filter_map(|g| g.offset(a, b, placement))
@@ -945,27 +949,37 @@ pub(crate) fn put_together(
 /// The pairs with at least [`PAIR_MIN_AGREEING`] agreeing correspondences that are at least
 /// [`PAIR_MIN_FRACTION`] of theirs, most agreeing first.
 fn links(pairs: &[[String; 2]], c: &[Correspondence], inliers: &[usize]) -> Vec<Link> {
-    let mut total: BTreeMap<usize, usize> = BTreeMap::new();
-    c.iter().for_each(|x| *total.entry(x.2).or_default() += 1);
-    let mut agreeing: BTreeMap<usize, usize> = BTreeMap::new();
-    inliers
-        .iter()
-        .for_each(|&k| *agreeing.entry(c[k].2).or_default() += 1);
+    let (total, agreeing) = per_pair(c, inliers);
     let mut out: Vec<Link> = agreeing
         .into_iter()
-        .filter(|&(p, n)| {
-            n >= PAIR_MIN_AGREEING && n as f64 >= PAIR_MIN_FRACTION * total[&p] as f64
+        .filter(|(p, m)| {
+            m.len() >= PAIR_MIN_AGREEING && m.len() as f64 >= PAIR_MIN_FRACTION * total[p] as f64
         })
-        .map(|(p, n)| Link {
+        .map(|(p, m)| Link {
             image1: pairs[p][0].clone(),
             image2: pairs[p][1].clone(),
             correspondences: total[&p],
-            agreeing: n,
+            agreeing: m.len(),
             dropped: Vec::new(),
         })
         .collect();
     by_agreeing(&mut out);
     out
+}
+
+/// Per database pair (its index), the matches that agree with a placement.
+type AgreeingByPair = BTreeMap<usize, BTreeSet<[u32; 2]>>;
+
+/// Each pair's correspondences (by pair index), and of them the matches that agree with a
+/// placement (those of `inliers`): what [`links`] and [`trimmed_links`] keep pairs by.
+fn per_pair(c: &[Correspondence], inliers: &[usize]) -> (BTreeMap<usize, usize>, AgreeingByPair) {
+    let mut total: BTreeMap<usize, usize> = BTreeMap::new();
+    c.iter().for_each(|x| *total.entry(x.2).or_default() += 1);
+    let mut agreeing = AgreeingByPair::new();
+    for &k in inliers {
+        agreeing.entry(c[k].2).or_default().insert(c[k].3);
+    }
+    (total, agreeing)
 }
 
 /// Links most agreeing correspondences first, then by name.
@@ -988,17 +1002,12 @@ fn trimmed_links(
     inliers: &[usize],
     evidence: &Evidence,
 ) -> Vec<Link> {
-    let mut total: BTreeMap<usize, usize> = BTreeMap::new();
-    c.iter().for_each(|x| *total.entry(x.2).or_default() += 1);
-    let mut kept: BTreeMap<usize, BTreeSet<[u32; 2]>> = BTreeMap::new();
-    for &k in inliers {
-        kept.entry(c[k].2).or_default().insert(c[k].3);
-    }
+    let (total, kept) = per_pair(c, inliers);
     let mut out: Vec<Link> = (kept.into_iter())
         .filter(|(_, m)| m.len() >= PAIR_MIN_AGREEING)
         .map(|(p, m)| {
-            let key = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
-            let all = evidence.matches.get(&(key[0].clone(), key[1].clone()));
+            let [first, second] = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
+            let all = evidence.matches.get(&(first, second));
             Link {
                 image1: pairs[p][0].clone(),
                 image2: pairs[p][1].clone(),
