@@ -35,8 +35,9 @@
 #                   clean models or place an image no model registered), `prune --model` with
 #                   every model so far and one more mapper run, a row `repairedK` per turn
 #                   [0]; the full database's model is checked too: where it is ghosted and
-#                   the pruned selection kept what glued it, or the pruned model the check
-#                   calls clean places most of that ghost's groups as it does (repair_loop.py),
+#                   the pruned selection kept what glued it, or the pruned model, whose
+#                   check gives the loop nothing to act on, places most of that ghost's
+#                   groups as it does (repair_loop.py),
 #                   it is the first of those models and the first turn runs whatever the
 #                   pruned model's check says; a turn whose prune selects what the last run
 #                   mapped ends the loop; in the loop's runs, the pruned one's too,
@@ -49,8 +50,8 @@
 #                   ends the loop, the model before it stands; the loop's answer
 #                   (WORKDIR/answer, summary.json's loop_answer) is its last run the check
 #                   calls clean (not the pruned run where the full model's evidence came
-#                   first), else its last run, or the full run where the pruned one made no
-#                   model
+#                   first), else the full run where the check calls it clean or the pruned
+#                   run made no model, else its last run
 set -euo pipefail
 [ $# -ge 2 ] || { echo "usage: $0 IMAGES WORKDIR [GT]" >&2; exit 2; }
 # This checkout, or the package's copy of its scripts (/usr/share/vgsel-colmap, run as
@@ -244,10 +245,14 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
     --report "$work/check_$last.json" $check_args >"$work/check_$last.txt" || status=$?
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
-  # A clean pruned model that places most of each group of the full model's ghost as it does
-  # is that ghost, hidden from the check (the plain design at 38 images): the full model's
-  # evidence comes first after all, whatever share of the selection it blames.
-  if [ "$status" = 0 ] && [ "$last" = pruned ] && [ -z "$full_evidence" ] &&
+  acts=1
+  python3 -c 'import json, sys; sys.exit(not any(json.load(open(sys.argv[1]))["repair"].values()))' \
+    "$work/check_$last.json" || acts=
+  # A pruned model the check gives nothing to act on (clean, or flagged only by an image that
+  # matches a third place) that places most of each group of the full model's ghost as it
+  # does is that ghost, hidden from the check (the plain design at 38 images): the full
+  # model's evidence comes first after all, whatever share of the selection it blames.
+  if [ -z "$acts" ] && [ "$last" = pruned ] && [ -z "$full_evidence" ] &&
     [ -f "$work/check_full.json" ] && shares=$("$here/scripts/repair_loop.py" same-ghost \
       "$bin" "$work/check_full.json" "$work/sparse_pruned"); then
     take_full_model "the pruned model places the full model's ghost as it does ($shares of its groups)"
@@ -255,9 +260,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   # A clean verdict answers, but the pruned run's where the full model's ghost came first:
   # there it is that ghost hidden (the twin's, every one at hand).
   [ "$status" = 0 ] && { [ "$last" != pruned ] || [ -z "$full_evidence" ]; } && answer=$last
-  { [ "$turn" = 1 ] && [ -n "$full_evidence" ]; } ||
-    python3 -c 'import json, sys; sys.exit(not any(json.load(open(sys.argv[1]))["repair"].values()))' \
-      "$work/check_$last.json" || break
+  { [ "$turn" = 1 ] && [ -n "$full_evidence" ]; } || [ -n "$acts" ] || break
   [ "$turn" -le "$REPAIR" ] || break
   models+=(--model "$work/sparse_$last")
   earlier+=(--earlier_model "$work/sparse_$last")
@@ -289,6 +292,14 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
     # the full database's model, what COLMAP alone gives, is then the answer, not nothing.
     answer=full
     log "the $last run made no model: the loop's answer is the full database's model, sparse_full"
+  elif [ -f "$work/check_full.json" ] &&
+    python3 -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["verdict"] != "clean")' \
+      "$work/check_full.json"; then
+    # No run of the loop is clean and COLMAP alone gave a model the check calls clean (the
+    # adjacent design, where the preset ghosts what the full database maps right and a turn
+    # can leave an image the repair cannot act on): that model is the answer.
+    answer=full
+    log "no run of the loop is clean and the full database's model is: the loop's answer is sparse_full"
   else
     answer=$last
     if made_model "$last"; then

@@ -11,9 +11,10 @@ on seven seeds). Where the selection left most of the ghost's pairs out (streets
 costs cameras (a 44-image street's image 0034 lost; on another street 19 of 44 right where the
 loop without it gave 44). Prints the share.
 
-same-ghost: whether the pruned model, which the check calls clean, is the full model's ghost
-again: most cameras of each of the ghost's two groups placed as the full model places them
-(`vgsel-colmap eval` of the pruned model against that ghosted model, its 5% and 5 degrees).
+same-ghost: whether the pruned model, whose check gives the loop nothing to act on (clean, or
+flagged only by an image that matches a third place), is the full model's ghost again: most
+cameras of each of the ghost's two groups placed as the full model places them (`vgsel-colmap
+eval` of the pruned model against that ghosted model, its 5% and 5 degrees).
 The check then cannot see a ghost the full model shows, and the loop takes the full model's
 evidence whatever its share: the plain design at 38 images, 38 of 38 cameras where the full
 ghost has them and 17% of the kept pairs blamed. Over 82 stored loops whose full model was
