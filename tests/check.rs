@@ -701,8 +701,11 @@ fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repa
 /// 3.8, through `scripts/pipeline.sh REPAIR=3`. COLMAP alone maps it right; the preset's
 /// selection, whose cost ranks its false pairs at chance (they hold more inliers than the true
 /// ones), ghosts it: each copy's orbit on the other's (fresh seeds 1-6 in session 51,
-/// docs/check.md). The check tells the two runs apart without the truth, and the loop ends with
-/// every camera right in one model. About two minutes on 2 cores.
+/// docs/check.md). The check tells the two runs apart without the truth, and the loop's answer
+/// has every camera right in one model: a turn's run, or, where no run of the loop is clean (a
+/// turn leaves an image matching a third place, which the repair does not act on: 2 of 4 fresh
+/// matchings in session 61), the full database's model the check calls clean. About two
+/// minutes on 2 cores.
 #[test]
 fn the_repair_loop_mends_the_adjacent_objects_the_preset_ghosts() {
     let (_dir, work) = pipeline(SceneKind::Adjacent, 24, 3);
@@ -752,8 +755,10 @@ fn check_flags_the_plain_designs_ghost_by_what_its_cameras_do_not_see() {
 /// selection, under the 40% that takes the full model's evidence, but the pruned model places
 /// most of each of the ghost's groups as the full model does (`repair_loop.py same-ghost`), so
 /// the loop takes that evidence first, and its answer has every camera right (fresh plain
-/// scenes of sessions 56-58, three mappers: 19 of 38 before, 38 after in 26 of 29 loops).
-/// About a minute and a half on 2 cores.
+/// scenes of sessions 56-58, three mappers: 19 of 38 before, 38 after in 26 of 29 loops). The
+/// same where the check flags the pruned model only by an image that matches a third place,
+/// which gives the loop nothing to act on (a CI run of session 60). About a minute and a half
+/// on 2 cores.
 #[test]
 fn the_repair_loop_sees_the_full_models_ghost_in_a_pruned_model_called_clean() {
     let (_dir, work) = pipeline(SceneKind::Plain, 38, 3);
@@ -762,7 +767,13 @@ fn the_repair_loop_sees_the_full_models_ghost_in_a_pruned_model_called_clean() {
     let (pruned, _, _) = variant_run(&work, "pruned");
     assert!(truth_ghosted(&full) && truth_ghosted(&pruned), "{checks:?}");
     assert_ne!(json(&work.join("check_full.json"))["verdict"], "clean");
-    if json(&work.join("check_pruned.json"))["verdict"] == "clean" {
+    let check = json(&work.join("check_pruned.json"));
+    let acts = check["repair"]
+        .as_object()
+        .unwrap()
+        .values()
+        .any(|v| v.as_array().is_some_and(|a| !a.is_empty()));
+    if check["verdict"] == "clean" || !acts {
         // The full model's evidence came first: a turn ran, its prune reading that model first.
         let first_turn = work.join("prune_repaired1.json");
         assert!(first_turn.exists(), "no turn: {checks:?}");
