@@ -206,7 +206,7 @@ map_and_eval full
 map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer" \
   "$work"/check_*.json
-last=pruned models=() earlier=() answer= full_evidence=
+last=pruned models=() earlier=() answer= full_evidence= full_clean=
 # The full model's evidence taken (for the reason `$1` says): the first model of every turn's
 # prune and every check's earlier model, and the pruned run no answer.
 take_full_model() {
@@ -225,6 +225,7 @@ if [ "${REPAIR:-0}" -gt 0 ] && made_model full; then
     --report "$work/check_full.json" $check_args >"$work/check_full.txt" || status=$?
   cat "$work/check_full.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
+  [ "$status" = 3 ] || full_clean=1
   if share=$("$here/scripts/repair_loop.py" full-model "$work/check_full.json" "$work/pruned.db"); then
     take_full_model "the full model's ghost blames $share of the pruned selection"
   fi
@@ -246,8 +247,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   acts=1
-  python3 -c 'import json, sys; sys.exit(not any(json.load(open(sys.argv[1]))["repair"].values()))' \
-    "$work/check_$last.json" || acts=
+  "$here/scripts/repair_loop.py" acts "$work/check_$last.json" || acts=
   # A pruned model the check gives nothing to act on (clean, or flagged only by an image that
   # matches a third place) that places most of each group of the full model's ghost as it
   # does is that ghost, hidden from the check (the plain design at 38 images): the full
@@ -292,9 +292,7 @@ if [ "${REPAIR:-0}" -gt 0 ]; then
     # the full database's model, what COLMAP alone gives, is then the answer, not nothing.
     answer=full
     log "the $last run made no model: the loop's answer is the full database's model, sparse_full"
-  elif [ -f "$work/check_full.json" ] &&
-    python3 -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["verdict"] != "clean")' \
-      "$work/check_full.json"; then
+  elif [ -n "$full_clean" ]; then
     # No run of the loop is clean and COLMAP alone gave a model the check calls clean (the
     # adjacent design, where the preset ghosts what the full database maps right and a turn
     # can leave an image the repair cannot act on): that model is the answer.

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Three decisions of scripts/pipeline.sh's repair loop, also for a loop run by hand (README,
+"""Four decisions of scripts/pipeline.sh's repair loop, also for a loop run by hand (README,
 "Is the model ghosted?"; docs/check.md, "The full model in the loop").
 
 full-model: whether the loop takes the full database's model as evidence: where the check calls
@@ -26,6 +26,11 @@ the two groups' shares.
 same-selection: whether two databases leave the same pairs valid with the same inliers: a turn
 whose prune selects what the last run mapped would only map it again.
 
+acts: whether a check's report gives `prune --model` anything to act on (its `repair`: pairs a
+ghost blames, matches to drop, pairs that place a group or image back, join clean models or
+place a lost image). A model flagged only by images that match a third place gives nothing:
+the check names them, and the repair takes none of their pairs.
+
 usage: scripts/repair_loop.py full-model CHECK_JSON PRUNED_DB
          CHECK_JSON  `vgsel-colmap check --report` of the full database's model
          PRUNED_DB   the pruned database (pairs with inliers are the kept ones)
@@ -33,6 +38,7 @@ usage: scripts/repair_loop.py full-model CHECK_JSON PRUNED_DB
          VGSEL         the vgsel-colmap binary
          PRUNED_MODEL  the pruned database's mapper output folder
        scripts/repair_loop.py same-selection DB1 DB2
+       scripts/repair_loop.py acts CHECK_JSON
 Exit status 0: yes; 1: no.
 """
 import json
@@ -94,6 +100,11 @@ def same_selection(first_db, second_db):
     return valid(first_db) == valid(second_db)
 
 
+def acts(check_json):
+    """Whether the report's `repair` lists anything."""
+    return any(json.load(open(check_json))["repair"].values())
+
+
 def main(argv):
     if len(argv) == 3 and argv[0] == "full-model":
         take, share = full_model(*argv[1:])
@@ -105,6 +116,8 @@ def main(argv):
         return 0 if same else 1
     if len(argv) == 3 and argv[0] == "same-selection":
         return 0 if same_selection(*argv[1:]) else 1
+    if len(argv) == 2 and argv[0] == "acts":
+        return 0 if acts(argv[1]) else 1
     sys.exit(__doc__)
 
 

@@ -2,7 +2,7 @@
 decides whether the repair loop takes that model's evidence (full-model), and so does a clean
 pruned model that places most of each of the ghost's groups as it does (same-ghost); a turn
 that leaves the same pairs and inliers valid as the last run's database is not mapped
-(same-selection)."""
+(same-selection); a turn runs only where the check's report lists something to act on (acts)."""
 import json
 import os
 import sqlite3
@@ -135,6 +135,23 @@ class SameSelection(unittest.TestCase):
     def test_another_pair_or_trimmed_inliers_are_not(self):
         self.assertEqual(self.same([("a.png", "b.png"), ("c.png", "d.png")]), 1)
         self.assertEqual(self.same([("a.png", "b.png"), ("b.png", "c.png")], b"\1" * 160), 1)
+
+
+class Acts(unittest.TestCase):
+    def acts(self, repair):
+        """Exit status of acts on a report whose `repair` is `repair`."""
+        with tempfile.TemporaryDirectory() as tmp:
+            report = os.path.join(tmp, "check.json")
+            json.dump({"verdict": "misplaced", "repair": repair}, open(report, "w"))
+            return subprocess.run([sys.executable, SCRIPT, "acts", report]).returncode
+
+    def test_a_report_with_a_pair_to_act_on_acts(self):
+        empty = {"blamed": [], "dropped": [], "links": [], "rejoin": []}
+        self.assertEqual(self.acts(empty | {"dropped": [["a.png", "b.png", 3, 4]]}), 0)
+
+    def test_a_report_flagged_with_nothing_listed_does_not(self):
+        # A misplaced image that matches a third place: named, nothing for the repair.
+        self.assertEqual(self.acts({"blamed": [], "dropped": [], "links": [], "rejoin": []}), 1)
 
 
 if __name__ == "__main__":
