@@ -354,8 +354,9 @@ def repair_loop(images, work, db, variant, order, kind, extra, tag):
     summary = json.load(open(os.path.join(loop, "summary.json")))
     answer = summary["loop_answer"]
     runs = [v for v in summary if v == "pruned" or v.startswith("repaired")]
-    report = "prune.json" if answer == "pruned" else f"prune_{answer}.json"
-    r = json.load(open(os.path.join(loop, report)))
+    # The full run answers where no run of the loop is clean and it is: no prune chose its pairs.
+    report = {"pruned": "prune.json", "full": None}.get(answer, f"prune_{answer}.json")
+    r = report and json.load(open(os.path.join(loop, report)))
     return dict(record(work, db, os.path.join(loop, f"{answer}.db"), r,
                        os.path.join(loop, f"sparse_{answer}"),
                        {"preset": "repair", "variant": variant, "order": order, "mapper": kind,

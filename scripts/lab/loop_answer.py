@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The repair loop's answer against its last run, over scripts/lab/repair-loop.sh's loop.json
 files: the loops whose answer (scripts/pipeline.sh's: its last run the check calls clean, else
-its last run with a model) is an earlier run, and the correct cameras summed both ways. A clean
+the full run where the check calls it clean or no run made a model, else its last run) is
+another run than the loop's last, and the correct cameras summed both ways. A full run that
+answers is recorded after the loop's runs (variant "full"). A clean
 run's turn (pieces joined, lost images placed) can end in a ghost that the loop has no turn left
 to repair; the clean run before it is the better answer (docs/check.md, "The loop's answer").
 
@@ -16,15 +18,17 @@ def main(paths):
     for path in paths:
         for row in json.load(open(path)):
             steps, k = row["steps"], row["answer"]
+            last = max(i for i, s in enumerate(steps) if s.get("variant") != "full")
             loops += 1
-            last_total += steps[-1]["correct"]
+            last_total += steps[last]["correct"]
             answer_total += steps[k]["correct"]
-            if k != len(steps) - 1:
+            if k != last:
                 changed += 1
                 print(f"{path} run {row['run']} {row['matching']} {row['mapper']}: correct by "
-                      f"run {[s['correct'] for s in steps]}, the answer is run {k + 1} "
-                      f"({steps[k]['correct']} against {steps[-1]['correct']})")
-    print(f"{loops} loops, {changed} answered by an earlier run; correct cameras summed: "
+                      f"run {[s['correct'] for s in steps[:last + 1]]}, the answer is "
+                      f"{'the full run' if k > last else f'run {k + 1}'} "
+                      f"({steps[k]['correct']} against {steps[last]['correct']})")
+    print(f"{loops} loops, {changed} answered by another run; correct cameras summed: "
           f"{answer_total} (the last runs: {last_total})")
 
 

@@ -7,7 +7,8 @@
 # WORKDIR/RUN/MATCHING/MAPPER: the full and the pruned database mapped, the loop's turns, every
 # model scored against the ground truth. Prints one row per run and mapper, after the loop its
 # answer (pipeline.sh's); writes WORKDIR/loop.json (per loop: its runs' correct cameras, models
-# and the check's verdict, from pipeline.sh's summary.json, and the answer's index among them).
+# and the check's verdict, from pipeline.sh's summary.json, and the answer's index among them;
+# where the full run answers, it is recorded after the loop's runs).
 # SCENE, NUM_IMAGES, SEED: another rendered design (demo-matching.sh). TURNS: the loop's turns at
 # most [3].
 # usage: scripts/lab/repair-loop.sh [WORKDIR] [RUNS] [MAPPERS]
@@ -61,7 +62,13 @@ for run in range(1, runs + 1):
             summary = json.load(open(path))
             steps = [step(v, e) for v, e in summary.items()
                      if v == "pruned" or v.startswith("repaired")]
-            answer = [s["variant"] for s in steps].index(summary.get("loop_answer", "pruned"))
+            turns = len(steps) - 1
+            answered = summary.get("loop_answer", "pruned")
+            if answered == "full":
+                # The full run answers (no run of the loop clean and it is, or no model): it is
+                # recorded after the loop's runs, as the step the answer points at.
+                steps.append(step("full", summary["full"]))
+            answer = [s["variant"] for s in steps].index(answered)
             full = summary["full"].get("correct", 0)
             rows.append(dict(run=run, matching=matcher, mapper=mapper, full_correct=full,
                              steps=steps, answer=answer))
@@ -69,7 +76,7 @@ for run in range(1, runs + 1):
             after = (f"{last['correct']:>20}/{n} {last['models']:>6} {last['check']:>10}"
                      if len(steps) > 1 else f"{'(not needed)':>23} {'':>6} {'':>10}")
             print(f"{run:>3} {matcher:<12} {mapper:<11} {full:>3}/{n} {first['correct']:>11}/{n} "
-                  f"{first['check']:>10} {len(steps) - 1:>5} {after}")
+                  f"{first['check']:>10} {turns:>5} {after}")
 final = [r["steps"][r["answer"]]["correct"] for r in rows]
 print(f"after the loop: {n}/{n} correct in {sum(c == n for c in final)} of {len(final)} runs; "
       f"before it: {sum(r['steps'][0]['correct'] == n for r in rows)} of {len(rows)}")

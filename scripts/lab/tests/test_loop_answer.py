@@ -25,6 +25,8 @@ class LoopAnswer(unittest.TestCase):
             ([step(30, ghosted=True), step(40), step(0, no_model=True)], 1),
             # Clean at the end: the last run.
             ([step(22, ghosted=True), step(44)], 1),
+            # Nothing clean, the full run is: recorded after the loop's runs.
+            ([step(13, ghosted=True), step(21, misplaced=True), step(24, variant="full")], 2),
         ]
         rows = [{"run": k + 1, "matching": "colmap3.8", "mapper": "colmap3.8", "steps": s,
                  "answer": a} for k, (s, a) in enumerate(loops)]
@@ -38,8 +40,10 @@ class LoopAnswer(unittest.TestCase):
         self.assertIn("the answer is run 2 (40 against 0)", out)
         self.assertNotIn(" run 2 colmap3.8", out)
         self.assertNotIn(" run 4 colmap3.8", out)
-        self.assertIn("4 loops, 2 answered by an earlier run; correct cameras summed: 158 "
-                      "(the last runs: 97)", out)
+        self.assertIn("correct by run [13, 21], the answer is the full run (24 against 21)",
+                      out)
+        self.assertIn("5 loops, 3 answered by another run; correct cameras summed: 182 "
+                      "(the last runs: 118)", out)
 
 
 if __name__ == "__main__":
