@@ -39,7 +39,8 @@
 #                   check gives the loop nothing to act on, places most of that ghost's
 #                   groups as it does (repair_loop.py),
 #                   it is the first of those models and the first turn runs whatever the
-#                   pruned model's check says; a turn whose prune selects what the last run
+#                   pruned model's check says (else, ghosted, it is each turn's check's and
+#                   prune's --earlier_model: its ghost refutes, blames nothing); a turn whose prune selects what the last run
 #                   mapped ends the loop; in the loop's runs, the pruned one's too,
 #                   the images the database links and an incremental mapper left out (a
 #                   piece the blame cut off: COLMAP 3.8 starts no second model from narrow
@@ -206,12 +207,12 @@ map_and_eval full
 map_and_eval pruned
 rm -f "$work"/eval_repaired*.json "$work"/sparse_repaired*.seconds "$work/answer" \
   "$work"/check_*.json
-last=pruned models=() earlier=() answer= full_evidence= full_clean=
+last=pruned models=() earlier=() answer= full_evidence= full_clean= full_ghost=()
 # The full model's evidence taken (for the reason `$1` says): the first model of every turn's
 # prune and every check's earlier model, and the pruned run no answer.
 take_full_model() {
   log "$1: its evidence comes first"
-  full_evidence=1 models=(--model "$work/sparse_full")
+  full_evidence=1 models=(--model "$work/sparse_full") full_ghost=()
   earlier=(--earlier_model "$work/sparse_full")
 }
 # The full database's model is evidence too where the check calls it ghosted and the pruned
@@ -226,6 +227,11 @@ if [ "${REPAIR:-0}" -gt 0 ] && made_model full; then
   cat "$work/check_full.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
   [ "$status" = 3 ] || full_clean=1
+  # Its ghost, without its blame, refutes what a turn's check would place where it had it and
+  # finds it again in a turn's model (an orbit's first images left on the other copy). Not in
+  # the pruned run's check: where that run is the full model's ghost, hidden, same-ghost below
+  # takes the full model's evidence whole.
+  [ "$status" = 0 ] || full_ghost=(--earlier_model "$work/sparse_full")
   if share=$("$here/scripts/repair_loop.py" full-model "$work/check_full.json" "$work/pruned.db"); then
     take_full_model "the full model's ghost blames $share of the pruned selection"
   fi
@@ -242,7 +248,10 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   fi
   status=0
   # shellcheck disable=SC2086
-  "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" "${earlier[@]}" \
+  ghost=()
+  [ "$last" = pruned ] || ghost=("${full_ghost[@]}")
+  "$bin" check --model "$work/sparse_$last" --database_path "$work/$last.db" "${ghost[@]}" \
+    "${earlier[@]}" \
     --report "$work/check_$last.json" $check_args >"$work/check_$last.txt" || status=$?
   cat "$work/check_$last.txt" >&2
   [ "$status" = 0 ] || [ "$status" = 3 ] || exit "$status"
@@ -267,7 +276,7 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   log "turn $turn: prune --model with the check's evidence (a ghost, a misplaced group or image, pieces or lost images)"
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
-    --report "$work/prune_repaired$turn.json" "${models[@]}" $prune_args $check_args
+    --report "$work/prune_repaired$turn.json" "${models[@]}" "${full_ghost[@]}" $prune_args $check_args
   if "$here/scripts/repair_loop.py" same-selection "$work/$last.db" "$work/repaired$turn.db"; then
     log "turn $turn selects what the $last run mapped: the loop stops"
     break

@@ -60,6 +60,9 @@ pub const THIRD_PLACE_APART: f64 = 0.1;
 /// than one image's tolerance ([`Glued::places_again`], [`MISPLACED_DISTANCE`]): a model
 /// refitted from another run's points scatters more than one camera placed by its matches.
 pub const GHOST_AGAIN: f64 = 0.2;
+/// Images of an earlier ghost's other side a model must hold to be the frame
+/// [`Glued::again_in`] judges the first side's images in: fewer fix no frame worth trusting.
+pub const AGAIN_FRAME: usize = 3;
 /// Placements tried per pair of models, most supported first.
 pub const PLACEMENTS: usize = 3;
 /// Random minimal samples (three correspondences) drawn per placement.
@@ -327,10 +330,47 @@ impl Glued {
         };
         let other =
             (model.images.iter()).filter(|im| self.groups[1 - side].contains(&im.image.name));
-        let (Some(to_ghost), Some(ghost)) = (self.to_ghost(other), self.cameras.get(image)) else {
-            return false;
+        self.to_ghost(other)
+            .is_some_and(|to_ghost| self.at_ghost(&to_ghost, image, centre))
+    }
+
+    /// The images of `model` on this ghost's side with fewer of them in it, where every one
+    /// sits where the ghost had it beside the other side's ([`Glued::places_again`]; that
+    /// side needs [`AGAIN_FRAME`] images): the refuted placement again, inside one model. An
+    /// orbit's first images see only an object both copies show alike, so they conflict with
+    /// next to nothing, and a selection that keeps their pairs to the other copy puts them
+    /// there again (plain 24-6201 and 24-6202: 0012, and 0012-0015, left on the first orbit's
+    /// copy, called clean at 0.15-0.20; docs/check.md). Every image of the side, not some: an
+    /// image the ghost grouped with that side yet had right stays clean beside its true
+    /// neighbours. Empty where none is.
+    pub fn again_in(&self, model: &SparseModel) -> Vec<String> {
+        let side = |k: usize| -> Vec<&SparseImage> {
+            let on = |im: &&SparseImage| self.groups[k].contains(&im.image.name);
+            model.images.iter().filter(on).collect()
         };
-        (to_ghost.apply(centre) - ghost.centre()).norm() <= MISPLACED_DISTANCE * self.spread()
+        let sides = [side(0), side(1)];
+        let few = usize::from(sides[1].len() < sides[0].len());
+        let (moved, frame) = (&sides[few], &sides[1 - few]);
+        if moved.is_empty() || frame.len() < AGAIN_FRAME {
+            return Vec::new();
+        }
+        let Some(to_ghost) = self.to_ghost(frame.iter().copied()) else {
+            return Vec::new();
+        };
+        let again =
+            |im: &&SparseImage| self.at_ghost(&to_ghost, &im.image.name, &im.image.centre());
+        match moved.iter().all(again) {
+            true => moved.iter().map(|im| im.image.name.clone()).collect(),
+            false => Vec::new(),
+        }
+    }
+
+    /// Whether camera centre `centre` of `image`, carried by `to_ghost` into the ghost's frame,
+    /// lies within [`MISPLACED_DISTANCE`] of the ghost's spread of where the ghost had it.
+    fn at_ghost(&self, to_ghost: &Similarity, image: &str, centre: &Vector3<f64>) -> bool {
+        self.cameras.get(image).is_some_and(|ghost| {
+            (to_ghost.apply(centre) - ghost.centre()).norm() <= MISPLACED_DISTANCE * self.spread()
+        })
     }
 
     /// The cameras of `images` this ghost has too: as given, and as the ghost had them.

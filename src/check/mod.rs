@@ -110,6 +110,11 @@ pub struct ModelCheck<'e> {
     /// images are the ghost, not its groups (a street's camera one building off, taken for a
     /// split of 16 against 28 images), and the repair acts on them alone.
     pub ghost_of_images: bool,
+    /// With the repair loop's earlier runs: images an earlier run's ghost had where this model
+    /// has them beside that ghost's other group ([`join::Glued::again_in`]). That ghost again,
+    /// however few its conflicts: the model is ghosted, split between them and the rest, and
+    /// the repair blames the pairs that hold them there. Sorted.
+    pub again: Vec<String>,
     /// The model's images in parts that share no 3D point with each other, where there are
     /// two or more (each part's names sorted, the largest part first): where the model put one
     /// part against the other rests on no structure it holds. An incremental mapper registers
@@ -305,6 +310,7 @@ pub fn check_model<'e>(
         ghost_placement: None,
         misplaced_images: Vec::new(),
         ghost_of_images: false,
+        again: Vec::new(),
         detached: detached(&views, &covisibility),
         unanchored,
         neighbours_apart,
@@ -814,6 +820,9 @@ pub fn check_run<'e>(
                         .collect();
                     c.ghost_of_images = !ghosted_without(model, &groups, &images, e, settings)?;
                 }
+                if !c.wrong() {
+                    ghost_again(model, c, e, settings, earlier);
+                }
                 c.refused = refused(c);
             }
             let checked: Vec<_> = models
@@ -833,6 +842,43 @@ pub fn check_run<'e>(
         joins,
         rejoined,
     })
+}
+
+/// Marks clean `c` ghosted where `model` holds an `earlier` run's ghost again
+/// ([`join::Glued::again_in`]): its worst split becomes those images against the rest, scored
+/// as any split, so the repair blames the pairs joining them.
+fn ghost_again(
+    model: &SparseModel,
+    c: &mut ModelCheck,
+    evidence: &Evidence,
+    settings: &CheckSettings,
+    earlier: &[join::Glued],
+) {
+    let Some(views) = &c.views else { return };
+    let Some(mut again) = earlier
+        .iter()
+        .map(|g| g.again_in(model))
+        .find(|a| !a.is_empty())
+    else {
+        return;
+    };
+    again.sort();
+    let side: Vec<bool> = (views.views.iter())
+        .map(|v| again.contains(&v.name))
+        .collect();
+    let covisibility = splits::Covisibility::new(views);
+    let reach = conflict::Reach::new(views, &settings.conflict);
+    let counts = conflict::count(views, &reach, &side, &settings.conflict);
+    let split = describe(
+        views,
+        &covisibility,
+        &side,
+        counts,
+        Some(&evidence.pairs),
+        settings,
+    );
+    (c.ghosted, c.score, c.side, c.again) = (true, split.score, side, again);
+    c.worst = Some(split);
 }
 
 /// Whether `split`, ghosted, is one image alone that its own matches (with the database)

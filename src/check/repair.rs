@@ -152,16 +152,18 @@ pub fn read_runs(dirs: &[std::path::PathBuf], option: &str) -> Result<Vec<Vec<Sp
 
 /// The repair's evidence from the repair loop's runs (`runs`, read from `dirs` in the order
 /// they ran; `option` names them in errors), each checked with the database's `evidence`
-/// after the ghosts of the runs before it ([`RunCheck::glued`]): each run's evidence, and the
-/// ghosts of them all for a later run's joins.
+/// after the ghosts of the runs before it ([`RunCheck::glued`]), `earlier`'s first (runs whose
+/// blame is not taken): each run's evidence, and the ghosts of them all for a later run's
+/// joins.
 pub fn loop_evidence(
     dirs: &[std::path::PathBuf],
     runs: &[Vec<SparseModel>],
     option: &str,
     evidence: &Evidence,
     settings: &CheckSettings,
+    mut earlier: Vec<join::Glued>,
 ) -> Result<(Vec<ModelEvidence>, Vec<join::Glued>)> {
-    let (mut found, mut earlier) = (Vec::new(), Vec::new());
+    let mut found = Vec::new();
     for (dir, models) in dirs.iter().zip(runs) {
         let run = check_run(models, Some(evidence), settings, &earlier)
             .with_context(|| format!("checking {option} {}", dir.display()))?;

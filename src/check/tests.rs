@@ -1488,6 +1488,50 @@ fn an_image_placed_where_an_earlier_ghost_had_it_is_not_misplaced() {
     }
 }
 
+/// A clean model whose last three images sit where an earlier run's ghost had them beside the
+/// other nine (the ghost in a frame of its own) holds that ghost again: ghosted, split between
+/// them and the rest, and the repair blames the pairs that hold them there (plain 24-6202's
+/// orbit start). A ghost that had them half a unit elsewhere, or had one of them elsewhere,
+/// finds nothing again: the model stays clean.
+#[test]
+fn a_model_that_holds_an_earlier_ghost_again_is_ghosted() {
+    let (model, evidence) = with_shift(0.0);
+    let last = |im: &SparseImage| im.image.image_id > 9;
+    let names = |of_last: bool| -> Vec<String> {
+        let images = model.images.iter().filter(|im| last(im) == of_last);
+        images.map(|im| im.image.name.clone()).collect()
+    };
+    let ghost_with = |shift: f64, moved: &dyn Fn(&SparseImage) -> bool| {
+        let mut shifted = model.clone();
+        for im in shifted.images.iter_mut().filter(|im| moved(im)) {
+            im.image.translation.x -= shift;
+        }
+        let (_, ghost) = two_models(&shifted, |_| true, 0, &elsewhere());
+        join::Glued::new(&ghost, [names(false), names(true)])
+    };
+    let check = |earlier: join::Glued| {
+        let models = std::slice::from_ref(&model);
+        check_run(models, Some(&evidence), &DEFAULT_SETTINGS, &[earlier]).unwrap()
+    };
+    let run = check(ghost_with(0.0, &last));
+    let c = &run.models[0];
+    assert!(c.ghosted && c.again == names(true), "{:?}", c.again);
+    assert!(c.worst.as_ref().unwrap().groups.contains(&names(true)));
+    let blamed = run.evidence().blamed;
+    assert!(!blamed.is_empty());
+    for [a, b] in &blamed {
+        assert!(
+            names(true).contains(a) != names(true).contains(b),
+            "{a} {b}"
+        );
+    }
+    let one = |im: &SparseImage| im.image.image_id == 12;
+    for earlier in [ghost_with(0.5, &last), ghost_with(0.5, &one)] {
+        let c = &check(earlier).models[0];
+        assert!(!c.wrong() && c.again.is_empty(), "{:?}", c.again);
+    }
+}
+
 /// A ghost of two groups of two images whose split joins a-c (sharing points) and b-d (not),
 /// with `images` its matches place elsewhere (`of_images`: they are the ghost), and its second
 /// group `placed` or not.

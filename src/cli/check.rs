@@ -125,6 +125,17 @@ fn verdict_line(dir: &Path, c: &ModelCheck, settings: &CheckSettings) -> String 
         if let Some(m) = &c.misplaced {
             line += &placement_text(m);
         }
+        if !c.again.is_empty() {
+            line += &format!(
+                "; where an earlier run's ghost had them: {}",
+                c.again
+                    .iter()
+                    .take(3)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            );
+        }
         if c.ghosted {
             line += &format!(
                 "; {} joining pairs, e.g. {}",
@@ -276,7 +287,15 @@ fn earlier_ghosts(
     match evidence {
         Some(e) => {
             let runs = check::repair::read_runs(dirs, "--earlier_model")?;
-            Ok(check::repair::loop_evidence(dirs, &runs, "--earlier_model", e, settings)?.1)
+            let found = check::repair::loop_evidence(
+                dirs,
+                &runs,
+                "--earlier_model",
+                e,
+                settings,
+                Vec::new(),
+            );
+            Ok(found?.1)
         }
         None => Ok(Vec::new()),
     }

@@ -71,6 +71,12 @@ pub struct PruneArgs {
     /// an earlier one blamed.
     #[arg(long, value_name = "DIR", help_heading = SELECT)]
     model: Vec<PathBuf>,
+    /// A mapper's output on this database checked before --model's, for its ghosts alone: no
+    /// pair of it is blamed, but what --model's check would place where its ghost had it is
+    /// refuted, and a --model folder that holds that ghost again is ghosted (the repair loop's
+    /// full database's model, where its blame is not taken: docs/check.md).
+    #[arg(long, value_name = "DIR", requires = "model", help_heading = SELECT)]
+    earlier_model: Vec<PathBuf>,
     /// A pair is a view-graph edge when it has at least this many verified inliers.
     #[arg(long, default_value_t = DEFAULT_MIN_NUM_MATCHES, help_heading = SELECT)]
     min_num_matches: usize,
@@ -169,6 +175,7 @@ impl PruneArgs {
             forbid_pairs: self.forbid_pairs.clone(),
             forbid_images: self.forbid_images.clone(),
             model: self.model.clone(),
+            earlier_model: self.earlier_model.clone(),
             check: Some(self.check.settings()),
             ..self.flow.given()
         }

@@ -50,6 +50,10 @@ pub struct ArcRules {
     /// (that glued a ghost, or that a wrong model refused) are never selected, and the pairs
     /// that link clean models are kept.
     pub model: Vec<PathBuf>,
+    /// `--earlier_model`: the repair loop's earlier mapper outputs whose blame is not taken
+    /// (the full database's, where its ghost is not `model`'s evidence): their ghosts refute
+    /// what `model`'s check would place where they had it, and find them again in a model.
+    pub earlier_model: Vec<PathBuf>,
     /// How the check judges `model`'s folders (`prune`'s check options).
     pub check: CheckSettings,
 }

@@ -67,6 +67,8 @@ pub struct Given {
     pub forbid_images: Option<PathBuf>,
     /// `--model`, each time it is given.
     pub model: Vec<PathBuf>,
+    /// `--earlier_model`, each time it is given.
+    pub earlier_model: Vec<PathBuf>,
     /// The check's options for `--model`'s folders (its defaults where not given).
     pub check: Option<check::CheckSettings>,
 }
@@ -188,6 +190,7 @@ impl Parameters {
                 forbid_pairs: given.forbid_pairs,
                 forbid_images: given.forbid_images,
                 model: given.model,
+                earlier_model: given.earlier_model,
                 check: given.check.unwrap_or_default(),
             },
         })
@@ -217,13 +220,28 @@ impl Parameters {
             // images each run lost.
             let mut evidence = check::evidence::Evidence::load(db)?;
             let runs = check::repair::read_runs(&rules.model, "--model")?;
+            let earlier_runs = check::repair::read_runs(&rules.earlier_model, "--earlier_model")?;
             let lost: BTreeSet<String> = (runs.iter())
                 .flat_map(|models| evidence.lost(models, self.min_num_matches))
                 .collect();
             evidence.read_lost(db, &lost)?;
             let settings = &rules.check;
-            let (found, _) =
-                check::repair::loop_evidence(&rules.model, &runs, "--model", &evidence, settings)?;
+            let (_, ghosts) = check::repair::loop_evidence(
+                &rules.earlier_model,
+                &earlier_runs,
+                "--earlier_model",
+                &evidence,
+                settings,
+                Vec::new(),
+            )?;
+            let (found, _) = check::repair::loop_evidence(
+                &rules.model,
+                &runs,
+                "--model",
+                &evidence,
+                settings,
+                ghosts,
+            )?;
             for (dir, found) in rules.model.iter().zip(found) {
                 let list = |pairs: Vec<[String; 2]>| NameList {
                     path: dir.to_path_buf(),
@@ -291,6 +309,9 @@ struct Recorded {
         deserialize_with = "one_or_more"
     )]
     model: Vec<String>,
+    /// `--earlier_model`'s folders, recorded since session 62.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    earlier_model: Vec<String>,
     /// The check's settings for `model`, where not the defaults.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     check: Option<check::CheckSettings>,
@@ -343,6 +364,9 @@ impl From<Parameters> for Recorded {
             model: (p.arc_rules.model.iter())
                 .map(|dir| dir.display().to_string())
                 .collect(),
+            earlier_model: (p.arc_rules.earlier_model.iter())
+                .map(|dir| dir.display().to_string())
+                .collect(),
             check: (p.arc_rules.check != check::DEFAULT_SETTINGS).then_some(p.arc_rules.check),
         }
     }
@@ -384,6 +408,7 @@ impl From<Recorded> for Parameters {
                 forbid_pairs: r.forbid_pairs.map(PathBuf::from),
                 forbid_images: r.forbid_images.map(PathBuf::from),
                 model: r.model.into_iter().map(PathBuf::from).collect(),
+                earlier_model: r.earlier_model.into_iter().map(PathBuf::from).collect(),
                 check: r.check.unwrap_or_default(),
             },
         }
