@@ -40,9 +40,9 @@
 #                   groups as it does (repair_loop.py),
 #                   it is the first of those models and the first turn runs whatever the
 #                   pruned model's check says (else, ghosted, it is each turn's check's and
-#                   prune's --earlier_model: its ghost refutes, blames nothing); a turn whose prune selects what the last run
-#                   mapped ends the loop; in the loop's runs, the pruned one's too,
-#                   the images the database links and an incremental mapper left out (a
+#                   prune's --earlier_model: its ghost refutes, blames nothing); a turn
+#                   whose prune selects what the last run mapped ends the loop; in the
+#                   loop's runs, the pruned one's too, the images the database links and an incremental mapper left out (a
 #                   piece the blame cut off: COLMAP 3.8 starts no second model from narrow
 #                   pairs, and COLMAP drops models under 10 images) are mapped on their own,
 #                   pieces of 3 kept (scripts/map-left-out.sh), into sparse_VARIANT/left,

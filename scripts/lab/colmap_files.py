@@ -166,14 +166,16 @@ def loop_runs(work):
 
 
 def turn_models(work, variant):
-    """The model folders a repair turn of `work` took as evidence (`prune --model`, in the
-    order given: its prune_VARIANT.json's parameters), which the pipeline then checked its run
-    after (`--earlier_model`); none for the full and pruned runs."""
+    """The model folders a repair turn of `work` took as evidence (`prune --earlier_model`,
+    then `--model`, in the order given: its prune_VARIANT.json's parameters), which the
+    pipeline then checked its run after (`--earlier_model`); none for the full and pruned
+    runs."""
     report = f"{work}/prune_{variant}.json"
     if variant in ("full", "pruned") or not os.path.exists(report):
         return []
     with open(report) as f:
-        return json.load(f)["parameters"].get("model") or []
+        parameters = json.load(f)["parameters"]
+    return (parameters.get("earlier_model") or []) + (parameters.get("model") or [])
 
 
 def pipeline_runs(top):
