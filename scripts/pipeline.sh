@@ -42,8 +42,8 @@
 #                   pruned model's check says (else, ghosted, it is each turn's check's and
 #                   prune's --earlier_model: its ghost refutes, blames nothing); a turn
 #                   whose prune selects what the last run mapped ends the loop; in the
-#                   loop's runs, the pruned one's too, the images the database links and an incremental mapper left out (a
-#                   piece the blame cut off: COLMAP 3.8 starts no second model from narrow
+#                   loop's runs, the pruned one's too, the images the database links and
+#                   an incremental mapper left out (a piece the blame cut off: COLMAP 3.8 starts no second model from narrow
 #                   pairs, and COLMAP drops models under 10 images) are mapped on their own,
 #                   pieces of 3 kept (scripts/map-left-out.sh), into sparse_VARIANT/left,
 #                   counted in the mapper's seconds (README); a run whose mapper makes no
@@ -276,7 +276,8 @@ for turn in $(seq 1 $((${REPAIR:-0} + 1))); do
   log "turn $turn: prune --model with the check's evidence (a ghost, a misplaced group or image, pieces or lost images)"
   # shellcheck disable=SC2086
   "$bin" prune -q --database_path "$work/full.db" --output "$work/repaired$turn.db" --overwrite \
-    --report "$work/prune_repaired$turn.json" "${models[@]}" "${full_ghost[@]}" $prune_args $check_args
+    --report "$work/prune_repaired$turn.json" "${models[@]}" "${full_ghost[@]}" \
+    $prune_args $check_args
   if "$here/scripts/repair_loop.py" same-selection "$work/$last.db" "$work/repaired$turn.db"; then
     log "turn $turn selects what the $last run mapped: the loop stops"
     break
