@@ -485,6 +485,30 @@ mod tests {
         assert_eq!(serde_json::to_value(&two).unwrap(), recorded);
     }
 
+    /// `--earlier_model`'s folders are recorded where given and read back as written; a record
+    /// without them (every one before session 62) loads with none.
+    #[test]
+    fn earlier_model_folders_are_recorded_where_given() {
+        let given = |earlier_model: Vec<PathBuf>| Given {
+            model: vec![PathBuf::from("sparse_pruned")],
+            earlier_model,
+            ..Given::default()
+        };
+        let none = Parameters::resolve(given(Vec::new())).unwrap();
+        let recorded = serde_json::to_value(&none).unwrap();
+        assert!(recorded.get("earlier_model").is_none(), "{recorded}");
+        let full = Parameters::resolve(given(vec![PathBuf::from("sparse_full")])).unwrap();
+        let recorded = serde_json::to_value(&full).unwrap();
+        assert_eq!(
+            recorded["earlier_model"],
+            serde_json::json!(["sparse_full"])
+        );
+        assert_eq!(
+            serde_json::from_value::<Parameters>(recorded).unwrap(),
+            full
+        );
+    }
+
     /// The check's settings for `--model` are recorded only where they are not the defaults
     /// (a record without them, as every earlier one, is the defaults), and read back as given.
     #[test]
