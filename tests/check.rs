@@ -659,7 +659,8 @@ fn repair_full_model(work: &Path, images: &Path, gt: &Path) -> (Value, PathBuf, 
 }
 
 /// A second turn of the loop (`--model` given twice: the full model and the repaired one) blames
-/// at least every pair the first turn blamed, and records both folders.
+/// at least every pair the first turn blamed, and records both folders; with the full model as
+/// `--earlier_model` instead, no pair the run with both as `--model` does not.
 fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repaired: &str) {
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let (full_model, report) = (s(&work.join("sparse_full")), s(&work.join("turn2.json")));
@@ -695,6 +696,53 @@ fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repa
         second["parameters"]["model"],
         serde_json::json!([full_model, repaired])
     );
+    // The full model as `--earlier_model`: its ghost is known to the repaired run's check as
+    // before, but none of its own blame is taken.
+    let earlier_report = s(&work.join("turn2_earlier.json"));
+    let out = vgsel(&[
+        "prune",
+        "-q",
+        "--preset",
+        "general",
+        "--dry_run",
+        "--database_path",
+        &database,
+        "--earlier_model",
+        &full_model,
+        "--model",
+        repaired,
+        "--report",
+        &earlier_report,
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let earlier = read(&earlier_report);
+    for pair in blamed(&earlier) {
+        assert!(
+            blamed(&second).contains(&pair),
+            "{pair} blamed only without the full model"
+        );
+    }
+    assert_eq!(
+        earlier["parameters"]["earlier_model"],
+        serde_json::json!([full_model])
+    );
+    assert_eq!(
+        earlier["parameters"]["model"],
+        serde_json::json!([repaired])
+    );
+    // Where the repaired run's check after the full model calls it clean, nothing is blamed.
+    let check = vgsel(&[
+        "check",
+        "--database_path",
+        &database,
+        "--earlier_model",
+        &full_model,
+        "--model",
+        repaired,
+    ]);
+    if check.status.code() == Some(0) {
+        assert_eq!(blamed(&earlier), Vec::<Value>::new(), "{check:?}");
+    }
 }
 
 /// Two identical objects side by side in one room (the adjacent design, 24 images), COLMAP
