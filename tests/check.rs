@@ -663,32 +663,25 @@ fn repair_full_model(work: &Path, images: &Path, gt: &Path) -> (Value, PathBuf, 
 /// `--earlier_model` instead, no pair the run with both as `--model` does not.
 fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repaired: &str) {
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let (full_model, report) = (s(&work.join("sparse_full")), s(&work.join("turn2.json")));
-    let database = s(&work.join("full.db"));
-    let out = vgsel(&[
-        "prune",
-        "-q",
-        "--preset",
-        "general",
-        "--dry_run",
-        "--database_path",
-        &database,
-        "--model",
-        &full_model,
-        "--model",
-        repaired,
-        "--report",
-        &report,
-    ]);
-    assert!(out.status.success(), "{out:?}");
-    let read = |path: &str| -> Value {
-        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    let (full_model, database) = (s(&work.join("sparse_full")), s(&work.join("full.db")));
+    // A dry run of `prune` on the full database with `folders` (options and their folders),
+    // its report.
+    let prune = |folders: &[&str], name: &str| -> Value {
+        let report = s(&work.join(name));
+        let mut args = vec!["prune", "-q", "--preset", "general", "--dry_run"];
+        args.extend(["--database_path", &database, "--report", &report]);
+        args.extend(folders);
+        let out = vgsel(&args);
+        assert!(out.status.success(), "{out:?}");
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
     };
     let blamed = |report: &Value| -> Vec<Value> {
         let list = &report["overrides"]["model_conflicts"];
         list.as_array().cloned().unwrap_or_default()
     };
-    let (first, second) = (read(first_report), read(&report));
+    let first: Value =
+        serde_json::from_str(&std::fs::read_to_string(first_report).unwrap()).unwrap();
+    let second = prune(&["--model", &full_model, "--model", repaired], "turn2.json");
     for pair in blamed(&first) {
         assert!(blamed(&second).contains(&pair), "{pair} not blamed again");
     }
@@ -698,29 +691,11 @@ fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repa
     );
     // The full model as `--earlier_model`: its ghost is known to the repaired run's check as
     // before, but none of its own blame is taken.
-    let earlier_report = s(&work.join("turn2_earlier.json"));
-    let out = vgsel(&[
-        "prune",
-        "-q",
-        "--preset",
-        "general",
-        "--dry_run",
-        "--database_path",
-        &database,
-        "--earlier_model",
-        &full_model,
-        "--model",
-        repaired,
-        "--report",
-        &earlier_report,
-    ]);
-    assert!(out.status.success(), "{out:?}");
-    let earlier = read(&earlier_report);
+    let folders = ["--earlier_model", &full_model, "--model", repaired];
+    let earlier = prune(&folders, "turn2_earlier.json");
     for pair in blamed(&earlier) {
-        assert!(
-            blamed(&second).contains(&pair),
-            "{pair} blamed only without the full model"
-        );
+        let only = "blamed only without the full model";
+        assert!(blamed(&second).contains(&pair), "{pair} {only}");
     }
     assert_eq!(
         earlier["parameters"]["earlier_model"],
@@ -731,15 +706,9 @@ fn second_turn_keeps_the_first_turns_blame(work: &Path, first_report: &str, repa
         serde_json::json!([repaired])
     );
     // Where the repaired run's check after the full model calls it clean, nothing is blamed.
-    let check = vgsel(&[
-        "check",
-        "--database_path",
-        &database,
-        "--earlier_model",
-        &full_model,
-        "--model",
-        repaired,
-    ]);
+    let mut args = vec!["check", "--database_path", &database];
+    args.extend(folders);
+    let check = vgsel(&args);
     if check.status.code() == Some(0) {
         assert_eq!(blamed(&earlier), Vec::<Value>::new(), "{check:?}");
     }
