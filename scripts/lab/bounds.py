@@ -16,7 +16,11 @@ Each model is also summed up by `colmap model_analyzer`: its observations and me
 error, how well it explains the images (a fold that explains as many observations as the truth's
 model, as finely, is a reconstruction no check on the model can refuse).
 
-usage: scripts/lab/bounds.py [--work DIR] [--global] [DESIGN:IMAGES:SEED ...]
+A design may also be a rendered scene already matched by `scripts/pipeline.sh` (a folder D
+holding `generate images --output D`'s images/ and gt/, and the loop's work/full.db): its own
+matching is then measured, not a new one, so the bound is that of the loop's database.
+
+usage: scripts/lab/bounds.py [--work DIR] [--global] [DESIGN:IMAGES:SEED | D ...]
        (WORK defaults to target/bounds)
 """
 import argparse
@@ -144,18 +148,33 @@ def map_and_score(db, images, gt, sparse, kind, baseline):
             "reprojection_px": error}
 
 
+def matched(spec, run_dir):
+    """run_dir/full.db: a copy of the pipeline's matching of the scene folder spec."""
+    db = os.path.join(run_dir, "full.db")
+    if not os.path.exists(db + ".done"):
+        shutil.copyfile(os.path.join(spec, "work", "full.db"), db)
+        open(db + ".done", "w").close()
+    return db
+
+
 def design(work, spec, mappers):
     """Every database and model of one design: its row of results."""
-    name, n, seed = spec.split(":")
-    top = os.path.join(work, f"{name}-{n}-s{seed}")
-    scene, run_dir = os.path.join(top, "scene"), os.path.join(top, "run")
+    if os.path.isdir(spec):
+        scene = os.path.abspath(spec)
+        top = os.path.join(work, os.path.basename(scene))
+        n = str(len(os.listdir(os.path.join(scene, "images"))))
+    else:
+        name, n, seed = spec.split(":")
+        top = os.path.join(work, f"{name}-{n}-s{seed}")
+        scene = os.path.join(top, "scene")
+        if not os.path.exists(os.path.join(scene, "gt", "scene.json")):
+            log(f"rendering {spec}")
+            run([VGSEL, "generate", "images", "--scene", name, "--num_images", n, "--seed",
+                 seed, "--output", scene])
+    run_dir = os.path.join(top, "run")
     gt, images = os.path.join(scene, "gt"), os.path.join(scene, "images")
-    if not os.path.exists(os.path.join(gt, "scene.json")):
-        log(f"rendering {spec}")
-        run([VGSEL, "generate", "images", "--scene", name, "--num_images", n, "--seed", seed,
-             "--output", scene])
     os.makedirs(run_dir, exist_ok=True)
-    full = match(scene, run_dir)
+    full = matched(spec, run_dir) if os.path.isdir(spec) else match(scene, run_dir)
     epi_gt = os.path.join(top, "gt_epipolar")
     os.makedirs(epi_gt, exist_ok=True)
     for f in ("cameras.txt", "images.txt", "points3D.txt"):

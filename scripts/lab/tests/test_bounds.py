@@ -36,5 +36,20 @@ class Run(unittest.TestCase):
                        tolerated="failed to create sparse model")
 
 
+class Matched(unittest.TestCase):
+    def test_a_pipeline_runs_matching_is_copied_once(self):
+        with tempfile.TemporaryDirectory() as d:
+            scene, run_dir = os.path.join(d, "street36-1"), os.path.join(d, "run")
+            os.makedirs(os.path.join(scene, "work"))
+            os.makedirs(run_dir)
+            with open(os.path.join(scene, "work", "full.db"), "w") as f:
+                f.write("matched")
+            db = bounds.matched(scene, run_dir)
+            self.assertEqual(open(db).read(), "matched")
+            with open(os.path.join(scene, "work", "full.db"), "w") as f:
+                f.write("matched again")
+            self.assertEqual(open(bounds.matched(scene, run_dir)).read(), "matched")
+
+
 if __name__ == "__main__":
     unittest.main()
