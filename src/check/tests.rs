@@ -25,6 +25,11 @@ impl Lcg {
     }
 }
 
+/// [`check_run`] at the default settings, no earlier run, on models that check.
+fn checked<'e>(models: &[SparseModel], evidence: &'e Evidence) -> RunCheck<'e> {
+    check_run(models, Some(evidence), &DEFAULT_SETTINGS, &[]).unwrap()
+}
+
 fn camera() -> ModelCamera {
     ModelCamera {
         camera_id: 1,
@@ -413,13 +418,7 @@ fn an_image_alone_is_blamed_only_on_the_pairs_that_hold_it_there() {
         let m = matches_of(other, misplaced, |id| id + offset);
         add_pair(&mut evidence, other, misplaced, m);
     }
-    let run = check_run(
-        std::slice::from_ref(&model),
-        Some(&evidence),
-        &DEFAULT_SETTINGS,
-        &[],
-    )
-    .unwrap();
+    let run = checked(std::slice::from_ref(&model), &evidence);
     assert!(run.models[0].ghosted, "score {}", run.models[0].score);
     let blamed = run.evidence().blamed;
     let expected: Vec<[String; 2]> = (1..=4)
@@ -1349,13 +1348,7 @@ fn a_ghosts_second_group_is_placed_back_by_its_true_pairs() {
         translation: back_from_elsewhere().translation - Vector3::new(5.0, 0.0, 0.0),
     };
     let one = join::put_together(&a, &b, &fold).0;
-    let run = check_run(
-        std::slice::from_ref(&one),
-        Some(&evidence),
-        &DEFAULT_SETTINGS,
-        &[],
-    )
-    .unwrap();
+    let run = checked(std::slice::from_ref(&one), &evidence);
     let c = &run.models[0];
     assert!(c.ghosted, "score {}", c.score);
     assert!(c.misplaced.is_none());
@@ -1411,7 +1404,7 @@ fn with_shift(shift: f64) -> (SparseModel, Evidence) {
 #[test]
 fn an_image_its_matches_place_elsewhere_is_misplaced() {
     let (model, evidence) = with_shift(0.0);
-    let in_place = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+    let in_place = checked(&[model], &evidence);
     assert!(in_place.models[0].misplaced_images.is_empty());
     assert!(!in_place.models[0].wrong());
     // Every image is placed, where the model has it.
@@ -1420,7 +1413,7 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     assert_eq!(placed.len(), views.views.len());
     assert!(placed.iter().all(|p| p.moved < 0.01), "{placed:?}");
     let (model, evidence) = with_shift(1.0);
-    let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+    let run = checked(&[model], &evidence);
     let c = &run.models[0];
     assert!(!c.ghosted, "score {}", c.score);
     assert!(c.wrong());
@@ -1440,7 +1433,7 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     // Eight units off (about four times the spread) is a jump, not a correction: not called
     // so.
     let (model, evidence) = with_shift(8.0);
-    let far = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+    let far = checked(&[model], &evidence);
     assert!(far.models[0].misplaced_images.is_empty());
     let placed = resection::image_placements(far.models[0].views.as_ref().unwrap()).unwrap();
     let p = placed.iter().find(|p| p.image == "0005.png").unwrap();
@@ -1451,7 +1444,7 @@ fn an_image_its_matches_place_elsewhere_is_misplaced() {
     for p in &mut model.images[4].points2d {
         p.point3d_id = None;
     }
-    let bare = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+    let bare = checked(&[model], &evidence);
     assert_eq!(bare.models[0].unanchored, ["0005.png"]);
     assert!(bare.models[0].misplaced_images.is_empty());
 }
@@ -1770,13 +1763,7 @@ fn chain(e: &mut Evidence, images: &[&SparseImage]) {
 
 /// The check of `model` with `evidence`: ghosted, its refused pairs and the repair.
 fn refused_of(model: &SparseModel, evidence: &Evidence) -> (bool, Vec<[String; 2]>, ModelEvidence) {
-    let run = check_run(
-        std::slice::from_ref(model),
-        Some(evidence),
-        &DEFAULT_SETTINGS,
-        &[],
-    )
-    .unwrap();
+    let run = checked(std::slice::from_ref(model), evidence);
     let c = &run.models[0];
     (c.ghosted, c.refused.clone(), run.evidence())
 }
@@ -1867,7 +1854,7 @@ fn only_matches_far_from_the_matches_pose_hold_a_misplaced_image() {
             });
             matches.push([first + n as u32, *k]);
         }
-        let run = check_run(&[model], Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+        let run = checked(&[model], &evidence);
         let [m] = &run.models[0].misplaced_images[..] else {
             panic!("{:?}", run.models[0].misplaced_images)
         };
@@ -1938,7 +1925,7 @@ fn add_lost(evidence: &mut Evidence, lost: &SparseImage) {
 fn an_image_the_mapper_lost_is_placed_by_its_true_pairs() {
     fn run_of<'e>(model: &SparseModel, evidence: &'e Evidence) -> RunCheck<'e> {
         let models = std::slice::from_ref(model);
-        check_run(models, Some(evidence), &DEFAULT_SETTINGS, &[]).unwrap()
+        checked(models, evidence)
     }
     let (model, evidence) = lost_image(correct_model());
     let run = run_of(&model, &evidence);
@@ -1998,7 +1985,7 @@ fn a_lost_image_whose_matches_name_a_third_place_is_not_placed() {
         }
         add_lost(&mut evidence, &lost);
         let models = std::slice::from_ref(&model);
-        let run = check_run(models, Some(&evidence), &DEFAULT_SETTINGS, &[]).unwrap();
+        let run = checked(models, &evidence);
         assert!(!run.models[0].wrong());
         run.rejoined
     };
