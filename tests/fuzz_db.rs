@@ -282,7 +282,8 @@ fn mutate(conn: &Connection, rng: &mut ChaCha8Rng) -> Option<String> {
                 )
                 .ok()?;
             let mut b = blob_at(conn, "keypoints", "data", rowid)?;
-            let stride = (cols.max(1) as usize) * 4;
+            // An earlier mutation of the case may have set cols to anything.
+            let stride = usize::try_from(cols).unwrap_or(1).clamp(1, 1 << 20) * 4;
             let x = *HOSTILE_F32.choose(rng).unwrap();
             let count = rng.gen_range(1..=3);
             for _ in 0..count {
