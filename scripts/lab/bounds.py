@@ -159,8 +159,13 @@ def matched(spec, run_dir):
 
 def design(work, spec, mappers):
     """Every database and model of one design: its row of results."""
-    if os.path.isdir(spec):
+    matched_already = os.path.isdir(spec)
+    if matched_already:
         scene = os.path.abspath(spec)
+        if not os.path.exists(os.path.join(scene, "gt", "scene.json")):
+            # Without the renderer's surfaces `eval --labels` falls back to the epipolar test,
+            # and the "truth" column would not be exact.
+            sys.exit(f"bounds: {spec} has no gt/scene.json: not a rendered scene")
         top = os.path.join(work, os.path.basename(scene))
         n = str(len(os.listdir(os.path.join(scene, "images"))))
     else:
@@ -174,7 +179,7 @@ def design(work, spec, mappers):
     run_dir = os.path.join(top, "run")
     gt, images = os.path.join(scene, "gt"), os.path.join(scene, "images")
     os.makedirs(run_dir, exist_ok=True)
-    full = matched(spec, run_dir) if os.path.isdir(spec) else match(scene, run_dir)
+    full = matched(spec, run_dir) if matched_already else match(scene, run_dir)
     epi_gt = os.path.join(top, "gt_epipolar")
     os.makedirs(epi_gt, exist_ok=True)
     for f in ("cameras.txt", "images.txt", "points3D.txt"):

@@ -50,6 +50,12 @@ class Matched(unittest.TestCase):
                 f.write("matched again")
             self.assertEqual(open(bounds.matched(scene, run_dir)).read(), "matched")
 
+    def test_a_folder_without_the_renderers_scene_is_refused(self):
+        with tempfile.TemporaryDirectory() as d:
+            os.makedirs(os.path.join(d, "photos", "images"))
+            with self.assertRaises(SystemExit):
+                bounds.design(d, os.path.join(d, "photos"), ["colmap3.8"])
+
 
 if __name__ == "__main__":
     unittest.main()
