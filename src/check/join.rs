@@ -34,6 +34,7 @@ use super::settings::{is_ghost, score, CheckSettings};
 use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
 use crate::geometry::similarity::Similarity;
+use crate::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -97,8 +98,7 @@ pub struct Link {
     pub correspondences: usize,
     /// Of those, the ones that agree with the placement.
     pub agreeing: usize,
-    /// For a trimmed link (kept with only its agreeing matches, where the placement explains
-    /// no whole pair after an earlier ghost: [`join_models`]): the pair's other matches
+    /// For a link kept with only its agreeing matches ([`Linking`]): the pair's other matches
     /// (keypoints in name order), which `prune --model` drops so that the pair is kept with
     /// those alone (in the report's `repair.dropped`). Empty for a link kept whole.
     #[serde(skip)]
@@ -537,8 +537,8 @@ pub(super) fn subset(model: &SparseModel, names: &[String]) -> SparseModel {
 ///
 /// Where no placement joins them and an earlier run's ghost lies between the two, the
 /// placements that explained too few whole pairs are judged again, strongest first, with
-/// [`trimmed_links`]: the first that does not conflict and scores under `accept_below` joins
-/// them, its pairs kept with only their agreeing matches.
+/// [`Linking::Trimmed`] links: the first that does not conflict and scores under
+/// `accept_below` joins them, its pairs kept with only their agreeing matches.
 fn join_two(
     models: [usize; 2],
     [a, b]: [&SparseModel; 2],
@@ -570,7 +570,13 @@ fn join_two(
         if inliers.len() < MIN_SUPPORT {
             break;
         }
-        let links = links(&pairs, &correspondences, &inliers);
+        let links = links(
+            &pairs,
+            &correspondences,
+            &inliers,
+            evidence,
+            Linking::Explained,
+        );
         let after_taken = taken.is_some();
         let (test, this) = tested.test(&placement, links, &inliers)?;
         if this.verdict == TriedVerdict::TooFew {
@@ -666,8 +672,9 @@ impl<'a> Tested<'a> {
 
     /// The last resort of [`join_two`], where no placement joined the two with whole pairs and
     /// an earlier ghost lies between them: the placements that explained `too_few` whole pairs
-    /// (on `pairs`), judged with [`trimmed_links`], strongest first; the first clean one that
-    /// scores under `accept_below` joins them. Else apart, after the placements `tried`.
+    /// (on `pairs`), judged with [`Linking::Trimmed`] links, strongest first; the first clean
+    /// one that scores under `accept_below` joins them. Else apart, after the placements
+    /// `tried`.
     fn with_trimmed_links(
         &self,
         pairs: &[[String; 2]],
@@ -677,7 +684,13 @@ impl<'a> Tested<'a> {
         accept_below: f64,
     ) -> anyhow::Result<Outcome> {
         for (placement, inliers) in too_few.iter().filter(|_| !self.ghosts.is_empty()) {
-            let links = trimmed_links(pairs, self.correspondences, inliers, self.evidence);
+            let links = links(
+                pairs,
+                self.correspondences,
+                inliers,
+                self.evidence,
+                Linking::Trimmed,
+            );
             let (test, this) = self.test(placement, links, inliers)?;
             tried.push(Tried {
                 trimmed: true,
@@ -986,21 +999,60 @@ pub(crate) fn put_together(
     (merged, from_b)
 }
 
-/// The pairs with at least [`PAIR_MIN_AGREEING`] agreeing correspondences that are at least
-/// [`PAIR_MIN_FRACTION`] of theirs, most agreeing first.
-fn links(pairs: &[[String; 2]], c: &[Correspondence], inliers: &[usize]) -> Vec<Link> {
+/// Which pairs link two models under a placement, and with which of their matches the repair
+/// keeps them ([`links`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Linking {
+    /// The pairs the placement explains: at least [`PAIR_MIN_FRACTION`] of their
+    /// correspondences agree. Each is kept with only its agreeing matches where those alone
+    /// are enough for a mapper to use the pair ([`DEFAULT_MIN_NUM_MATCHES`]), whole where not.
+    /// A street's pair that sees one building in both images and the next building in one of
+    /// them holds matches of both places: kept whole, its matches of the next building led the
+    /// mapper to draw 12 cameras a building along (street 30-6303, session 64: 45 of its 90
+    /// correspondences agreed with the true join); trimmed, the same database mapped 30 of 30.
+    Explained,
+    /// Every pair with [`PAIR_MIN_AGREEING`] agreeing correspondences, whatever share of
+    /// theirs that is, kept with those alone: the links of two orbits whose true placement
+    /// explains no whole pair, because every pair that holds its correspondences holds more
+    /// of the ghost's (plain 38-6014: 5-39 agreeing of 96-317 matches; trimmed so, the mapper
+    /// makes one correct model with every mapper tried: docs/check.md).
+    Trimmed,
+}
+
+/// The pairs that link two models under a placement (`linking`), most agreeing first: each
+/// with at least [`PAIR_MIN_AGREEING`] correspondences among `inliers`, and where kept
+/// trimmed, the pair's other matches (from the database) as [`Link::dropped`].
+fn links(
+    pairs: &[[String; 2]],
+    c: &[Correspondence],
+    inliers: &[usize],
+    evidence: &Evidence,
+    linking: Linking,
+) -> Vec<Link> {
     let (total, agreeing) = per_pair(c, inliers);
-    let mut out: Vec<Link> = agreeing
-        .into_iter()
-        .filter(|(p, m)| {
-            m.len() >= PAIR_MIN_AGREEING && m.len() as f64 >= PAIR_MIN_FRACTION * total[p] as f64
-        })
-        .map(|(p, m)| Link {
-            image1: pairs[p][0].clone(),
-            image2: pairs[p][1].clone(),
-            correspondences: total[&p],
-            agreeing: m.len(),
-            dropped: Vec::new(),
+    let explained = |p: &usize, m: &BTreeSet<[u32; 2]>| {
+        linking == Linking::Trimmed || m.len() as f64 >= PAIR_MIN_FRACTION * total[p] as f64
+    };
+    let trimmed =
+        |m: &BTreeSet<[u32; 2]>| linking == Linking::Trimmed || m.len() >= DEFAULT_MIN_NUM_MATCHES;
+    let mut out: Vec<Link> = (agreeing.into_iter())
+        .filter(|(p, m)| m.len() >= PAIR_MIN_AGREEING && explained(p, m))
+        .map(|(p, m)| {
+            let [first, second] = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
+            let all = evidence
+                .matches
+                .get(&(first, second))
+                .filter(|_| trimmed(&m));
+            Link {
+                image1: pairs[p][0].clone(),
+                image2: pairs[p][1].clone(),
+                correspondences: total[&p],
+                agreeing: m.len(),
+                dropped: (all.into_iter().flatten())
+                    .filter(|x| !m.contains(*x))
+                    .copied()
+                    .collect(),
+            }
         })
         .collect();
     by_agreeing(&mut out);
@@ -1011,7 +1063,7 @@ fn links(pairs: &[[String; 2]], c: &[Correspondence], inliers: &[usize]) -> Vec<
 type AgreeingByPair = BTreeMap<usize, BTreeSet<[u32; 2]>>;
 
 /// Each pair's correspondences (by pair index), and of them the matches that agree with a
-/// placement (those of `inliers`): what [`links`] and [`trimmed_links`] keep pairs by.
+/// placement (those of `inliers`): what [`links`] keeps pairs by.
 fn per_pair(c: &[Correspondence], inliers: &[usize]) -> (BTreeMap<usize, usize>, AgreeingByPair) {
     let mut total: BTreeMap<usize, usize> = BTreeMap::new();
     c.iter().for_each(|x| *total.entry(x.2).or_default() += 1);
@@ -1029,39 +1081,6 @@ fn by_agreeing(links: &mut [Link]) {
             .cmp(&x.agreeing)
             .then((&x.image1, &x.image2).cmp(&(&y.image1, &y.image2)))
     });
-}
-
-/// The pairs that hold at least [`PAIR_MIN_AGREEING`] correspondences agreeing with a
-/// placement, whatever share of theirs that is, each kept with only those matches: the links
-/// of two orbits whose true placement explains no whole pair, because every pair that holds its
-/// correspondences holds more of the ghost's (plain 38-6014: 5-39 agreeing of 96-317 matches;
-/// trimmed so, the mapper makes one correct model with every mapper tried: docs/check.md).
-fn trimmed_links(
-    pairs: &[[String; 2]],
-    c: &[Correspondence],
-    inliers: &[usize],
-    evidence: &Evidence,
-) -> Vec<Link> {
-    let (total, kept) = per_pair(c, inliers);
-    let mut out: Vec<Link> = (kept.into_iter())
-        .filter(|(_, m)| m.len() >= PAIR_MIN_AGREEING)
-        .map(|(p, m)| {
-            let [first, second] = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
-            let all = evidence.matches.get(&(first, second));
-            Link {
-                image1: pairs[p][0].clone(),
-                image2: pairs[p][1].clone(),
-                correspondences: total[&p],
-                agreeing: m.len(),
-                dropped: (all.into_iter().flatten())
-                    .filter(|x| !m.contains(*x))
-                    .copied()
-                    .collect(),
-            }
-        })
-        .collect();
-    by_agreeing(&mut out);
-    out
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ use super::*;
 use crate::colmap::model::{ModelCamera, ModelImage};
 use crate::colmap::sparse::{Point2D, SparseImage};
 use crate::geometry::similarity::Similarity;
+use crate::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 use nalgebra::{UnitQuaternion, Vector3};
 use std::collections::BTreeSet;
 
@@ -1283,6 +1284,53 @@ fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_ref
         let [ia, ib] = [&l.image1, &l.image2].map(|n| n[..4].parse::<u32>().unwrap());
         assert!(ib != ia + 6, "a twin pair links: {l:?}");
         assert!(l.agreeing * 2 >= l.correspondences, "{l:?}");
+    }
+}
+
+/// A pair the taken placement explains that holds matches of another place too (a street's
+/// pair that sees one building in both images and the next in one of them): the repair keeps
+/// it with only its agreeing matches where those alone are enough for a mapper to use the pair,
+/// whole where not (street 30-6303: kept whole, such pairs drew 12 cameras a building along).
+#[test]
+fn a_link_is_kept_with_only_the_matches_its_placement_explains() {
+    let (a, b, mut evidence) = hall_like();
+    let in_a: BTreeSet<String> = a.images.iter().map(|im| im.image.name.clone()).collect();
+    let crossing = |key: &(String, String)| in_a.contains(&key.0) != in_a.contains(&key.1);
+    // The weakest linking pair keeps 9 true matches: too few for a mapper alone.
+    let weakest = (evidence.matches.iter())
+        .filter(|(key, m)| crossing(key) && m.len() >= 15)
+        .min_by_key(|(_, m)| m.len())
+        .map(|(key, _)| key.clone())
+        .unwrap();
+    evidence.matches.get_mut(&weakest).unwrap().truncate(9);
+    let mut false_ones = BTreeMap::new();
+    for (key, m) in evidence.matches.iter_mut() {
+        // One false match for every third true one: [k's first keypoint, k+1's second].
+        let n = m.len();
+        if crossing(key) && n >= 3 {
+            let added: Vec<[u32; 2]> = (0..n / 3).map(|k| [m[k][0], m[k + 1][1]]).collect();
+            m.extend(&added);
+            false_ones.insert(key.clone(), added);
+        }
+    }
+    let pair = [(&a, false), (&b, false)];
+    let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[]).unwrap();
+    assert_eq!(joins.joined.len(), 1, "{joins:?}");
+    let links = &joins.joined[0].links;
+    let enough = |l: &&join::Link| l.agreeing >= DEFAULT_MIN_NUM_MATCHES;
+    assert!(links.iter().any(|l| enough(&l)), "{links:?}");
+    assert!(links.iter().any(|l| !enough(&l)), "{links:?}");
+    for link in links {
+        let key = (link.image1.clone(), link.image2.clone());
+        let key = if key.0 < key.1 { key } else { (key.1, key.0) };
+        let mut dropped = link.dropped.clone();
+        dropped.sort_unstable();
+        let mut expected = match enough(&link) {
+            true => false_ones[&key].clone(),
+            false => Vec::new(),
+        };
+        expected.sort_unstable();
+        assert_eq!(dropped, expected, "{link:?}");
     }
 }
 

@@ -374,15 +374,16 @@ fn join_line(dirs: &[PathBuf], j: &check::join::Join) -> String {
     ) + &trimmed_text(&j.links)
 }
 
-/// For links kept with only their agreeing matches ([`check::join::Link::dropped`]): how many
-/// matches stay and how many the repair drops.
+/// For links kept with only their agreeing matches ([`check::join::Link::dropped`]): how many,
+/// how many matches they keep and how many the repair drops.
 fn trimmed_text(links: &[check::join::Link]) -> String {
-    let dropped: usize = links.iter().map(|l| l.dropped.len()).sum();
-    match dropped {
+    let trimmed: Vec<_> = links.iter().filter(|l| !l.dropped.is_empty()).collect();
+    let dropped: usize = trimmed.iter().map(|l| l.dropped.len()).sum();
+    match trimmed.len() {
         0 => String::new(),
-        _ => format!(
-            ", kept with only their {} agreeing matches ({dropped} others dropped)",
-            links.iter().map(|l| l.agreeing).sum::<usize>()
+        n => format!(
+            ", {n} kept with only their {} agreeing matches ({dropped} others dropped)",
+            trimmed.iter().map(|l| l.agreeing).sum::<usize>()
         ),
     }
 }
