@@ -8,8 +8,11 @@ usage: PY scripts/lab/trimmed-links.py REPORT K DB OUT_DB
 
   REPORT  a `check --report` JSON of the run (with --database_path; since session 60 its
           `apart` and `joins` list the placements `tried`); its first pair of models with any
-  K       index of the placement in that pair's `tried` (the true one, by join-truth.py)
-  DB      the run's database (a prune's: pairs it invalidated come back from vgsel_backup)
+  K       index of the placement in that pair's `tried` (the true one, by join-truth.py); or
+          `joins`: every join of the report by its own placement, only its `links` trimmed
+          (a link kept whole before session 64, docs/check.md "A join's links")
+  DB      the run's database (a prune's: pairs it invalidated come back from vgsel_backup);
+          with `joins`, the next turn's database, which holds the links whole
   OUT_DB  the copy written; map it (`colmap mapper`, scripts/ci/colmap4.py map) and `eval` it
 
 A match agrees when its two keypoints lie on points of their models that the placement puts
@@ -38,23 +41,36 @@ def keypoint_points(rec):
 def main():
     if len(sys.argv) != 5:
         sys.exit(__doc__)
-    report, k, db_path, out = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
+    report, k, db_path, out = sys.argv[1:]
     r = json.load(open(report))
-    pair = [p for p in r["apart"] + r["joins"] if p.get("tried")][0]
-    placement = pair["tried"][k]["placement"]
+    shutil.copy(db_path, out)
+    db = sqlite3.connect(out)
+    if k == "joins":
+        for join in r["joins"]:
+            links = {(l["image1"], l["image2"]) for l in join["links"]}
+            trim(db, join["model_paths"], join["placement"], links)
+    else:
+        pair = [p for p in r["apart"] + r["joins"] if p.get("tried")][0]
+        trim(db, pair["model_paths"], pair["tried"][int(k)]["placement"], None)
+    db.commit()
+
+
+def trim(db, model_paths, placement, links):
+    """The pairs between the two models holding 5 or more matches that agree with placement
+    (only those in links, image of the first model first, where given) kept with just those."""
     scale, rotation = placement["scale"], np.array(placement["rotation"])
     translation = np.array(placement["translation"])
-    a, b = (pycolmap.Reconstruction(p) for p in pair["model_paths"])
+    a, b = (pycolmap.Reconstruction(p) for p in model_paths)
     points = np.array([p.xyz for p in a.points3D.values()])
     tolerance = 0.01 * np.median(np.linalg.norm(points - points.mean(0), axis=1))
     on_a, on_b = keypoint_points(a), keypoint_points(b)
-    shutil.copy(db_path, out)
-    db = sqlite3.connect(out)
     ids = {name: i for i, name in db.execute("SELECT image_id, name FROM images")}
     columns = ", ".join(c[1] for c in db.execute("PRAGMA table_info(two_view_geometries)"))
     kept = agreeing_total = 0
     for name_a, points_a in on_a.items():
         for name_b, points_b in on_b.items():
+            if links is not None and (name_a, name_b) not in links:
+                continue
             first, second = ids[name_a], ids[name_b]
             swap = first > second
             pair_id = min(first, second) * MAX_IMAGE_ID + max(first, second)
@@ -85,7 +101,6 @@ def main():
             kept += 1
             agreeing_total += len(agreeing)
             print(f"{name_a} {name_b}: {len(agreeing)} of {len(matches)} matches kept")
-    db.commit()
     print(f"{kept} pairs kept with {agreeing_total} agreeing matches (tolerance {tolerance:.4f})")
 
 

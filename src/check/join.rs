@@ -13,7 +13,7 @@
 //! links (why the mapper glued the copies in the first place) it is the strongest; it
 //! conflicts, and the next placement that does not joins the models. The database pairs it
 //! explains are the links a mapper needs to make one model of the two (`prune --model` keeps
-//! them).
+//! them, with only the matches the placement explains where those are enough: [`Linking`]).
 //!
 //! Only after a stronger placement conflicted: where the strongest does not, it may be a ghost
 //! the check cannot see (copies that share their surroundings), and nothing tells it from a
