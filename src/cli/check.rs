@@ -252,7 +252,7 @@ fn placement_text(m: &check::join::Join) -> String {
         m.refuted,
         m.links.len(),
         examples(m.links.iter().map(|l| (&l.image1, &l.image2)))
-    )
+    ) + &trimmed_text(&m.links)
 }
 
 /// The first three `pairs` as `a-b c-d e-f`.
