@@ -8,8 +8,8 @@ use super::resection::{DOMINANT_SUPPORT, THIRD_PLACE_RATIO, THIRD_PLACE_SHARE};
 use super::*;
 use crate::colmap::model::{ModelCamera, ModelImage};
 use crate::colmap::sparse::{Point2D, SparseImage};
+use crate::colmap::DEFAULT_MIN_NUM_MATCHES;
 use crate::geometry::similarity::Similarity;
-use crate::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 use nalgebra::{UnitQuaternion, Vector3};
 use std::collections::BTreeSet;
 

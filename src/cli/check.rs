@@ -12,8 +12,8 @@ use vgsel_colmap::check::{self, CheckSettings, ModelCheck, Verdict};
 use vgsel_colmap::colmap::database::Database;
 use vgsel_colmap::colmap::model::model_dirs;
 use vgsel_colmap::colmap::sparse::{read_sparse_model, SparseModel};
+use vgsel_colmap::colmap::DEFAULT_MIN_NUM_MATCHES;
 use vgsel_colmap::geometry::similarity::Similarity;
-use vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES;
 
 /// Exit status of a check that found a model wrong: ghosted, with a misplaced group or image,
 /// folded against the capture order (`--sequence`), or with images registered on (next to) no

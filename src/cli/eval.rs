@@ -41,7 +41,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "FILE", requires = "database_path")]
     placements: Option<PathBuf>,
     /// A pair is used by the mapper with at least this many inliers (--Mapper.min_num_matches).
-    #[arg(long, default_value_t = vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES)]
+    #[arg(long, default_value_t = vgsel_colmap::colmap::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
 }
 

@@ -17,7 +17,7 @@ pub struct InspectArgs {
     #[command(flatten)]
     database: DatabaseArg,
     /// A pair counts when it has at least this many verified inliers (as --Mapper.min_num_matches).
-    #[arg(long, default_value_t = vgsel_colmap::selection::parameters::DEFAULT_MIN_NUM_MATCHES)]
+    #[arg(long, default_value_t = vgsel_colmap::colmap::DEFAULT_MIN_NUM_MATCHES)]
     min_num_matches: usize,
     /// Print JSON instead of text.
     #[arg(long)]

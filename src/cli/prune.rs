@@ -8,12 +8,13 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use vgsel_colmap::colmap::database::Database;
+use vgsel_colmap::colmap::DEFAULT_MIN_NUM_MATCHES;
 use vgsel_colmap::colmap::{copy, rewrite};
 use vgsel_colmap::costs::Mean;
 use vgsel_colmap::outputs::report::{Outputs, Report};
 use vgsel_colmap::outputs::{export, plots, scores};
 use vgsel_colmap::selection::capture_order::Order;
-use vgsel_colmap::selection::parameters::{Flow, Given, Parameters, DEFAULT_MIN_NUM_MATCHES};
+use vgsel_colmap::selection::parameters::{Flow, Given, Parameters};
 use vgsel_colmap::selection::pipeline::{self as prune, Extras, Plan};
 use vgsel_colmap::selection::preset::Preset;
 
@@ -66,7 +67,8 @@ pub struct PruneArgs {
     /// refused among the images it placed consistently, are never selected, the pairs
     /// that link clean models `check` joins or place a misplaced image back are kept, so are
     /// the pairs that place an image no model registered in a clean model (unless blamed), and the
-    /// matches that held a misplaced image are dropped from the pairs kept (docs/check.md).
+    /// matches that held a misplaced image, or that a link's placement does not explain, are
+    /// dropped from the pairs kept (docs/check.md).
     /// Repeat it with every earlier turn's output, in order, so that no turn selects again what
     /// an earlier one blamed.
     #[arg(long, value_name = "DIR", help_heading = SELECT)]

@@ -11,3 +11,6 @@ pub mod rewrite;
 pub mod schema;
 pub mod sparse;
 pub mod wal;
+
+/// COLMAP's default `--Mapper.min_num_matches`: fewer verified inliers make no view-graph edge.
+pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;

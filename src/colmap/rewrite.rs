@@ -43,7 +43,7 @@ impl Edits {
 }
 
 /// A pair kept with fewer inliers: `prune --model` drops the matches that held a misplaced
-/// image where a model put it.
+/// image where a model put it, and a link's matches its placement does not explain.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trim {
     /// The pair.

@@ -51,7 +51,8 @@ pub struct Report {
     /// Edges invalidated (or that would be, on a dry run): `pairs_total - pairs_selected`.
     pub pairs_invalidated: usize,
     /// Selected edges kept with fewer inliers: `--model` dropped the matches that held a
-    /// misplaced image where a mapper put it.
+    /// misplaced image where a mapper put it, and a link's matches its placement does not
+    /// explain.
     pub pairs_trimmed: usize,
     /// The inliers those pairs lost.
     pub matches_dropped: usize,
@@ -287,7 +288,8 @@ impl Report {
         }
         if self.pairs_trimmed > 0 {
             s += &format!(
-                "\nmodel check: {} matches that held misplaced images dropped from {} kept pairs",
+                "\nmodel check: {} matches dropped from {} kept pairs (holding misplaced images, \
+                 or not explained by a link's placement)",
                 self.matches_dropped, self.pairs_trimmed
             );
         }

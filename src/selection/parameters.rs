@@ -8,6 +8,7 @@
 
 use crate::check;
 use crate::colmap::database::Database;
+use crate::colmap::DEFAULT_MIN_NUM_MATCHES;
 use crate::costs::{CostModel, Mean};
 use crate::flow::search::{Criteria, FlowRule, GivenCriteria};
 use crate::named::Named;
@@ -20,9 +21,6 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
-
-/// COLMAP's default `--Mapper.min_num_matches`: fewer verified inliers make no view-graph edge.
-pub const DEFAULT_MIN_NUM_MATCHES: usize = 15;
 
 /// A prune's options as the user gave them; `None` (or empty) takes the default.
 #[derive(Clone, Debug, Default)]
