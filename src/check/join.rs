@@ -13,7 +13,7 @@
 //! links (why the mapper glued the copies in the first place) it is the strongest; it
 //! conflicts, and the next placement that does not joins the models. The database pairs it
 //! explains are the links a mapper needs to make one model of the two (`prune --model` keeps
-//! them, with only the matches the placement explains where those are enough: [`Linking`]).
+//! them, with only the matches the placement explains where those are enough: `Linking`).
 //!
 //! Only after a stronger placement conflicted: where the strongest does not, it may be a ghost
 //! the check cannot see (copies that share their surroundings), and nothing tells it from a
@@ -98,7 +98,7 @@ pub struct Link {
     pub correspondences: usize,
     /// Of those, the ones that agree with the placement.
     pub agreeing: usize,
-    /// For a link kept with only its agreeing matches ([`Linking`]): the pair's other matches
+    /// For a link kept with only its agreeing matches (`Linking`): the pair's other matches
     /// (keypoints in name order), which `prune --model` drops so that the pair is kept with
     /// those alone (in the report's `repair.dropped`). Empty for a link kept whole.
     #[serde(skip)]
