@@ -1004,12 +1004,15 @@ pub(crate) fn put_together(
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Linking {
     /// The pairs the placement explains: at least [`PAIR_MIN_FRACTION`] of their
-    /// correspondences agree. Each is kept with only its agreeing matches where those alone
-    /// are enough for a mapper to use the pair ([`DEFAULT_MIN_NUM_MATCHES`]), whole where not.
-    /// A street's pair that sees one building in both images and the next building in one of
-    /// them holds matches of both places: kept whole, its matches of the next building led the
-    /// mapper to draw 12 cameras a building along (street 30-6303, session 64: 45 of its 90
-    /// correspondences agreed with the true join); trimmed, the same database mapped 30 of 30.
+    /// correspondences agree. A pair that also holds a second place, as many correspondences
+    /// the placement does not explain as a mapper needs to use a pair
+    /// ([`DEFAULT_MIN_NUM_MATCHES`]), is kept with only its agreeing matches where those too
+    /// are that many; any other is kept whole. A street's pair that sees one building in both
+    /// images and the next building in one of them holds matches of both places: kept whole,
+    /// its matches of the next building led the mapper to draw 12 cameras a building along
+    /// (street 30-6303, session 64: 45 of its 90 correspondences agreed with the true join);
+    /// trimmed, the same database mapped 30 of 30. Trimmed of its disagreeing correspondences
+    /// alone, keeping its matches on no point, it did not (docs/check.md).
     Explained,
     /// Every pair with [`PAIR_MIN_AGREEING`] agreeing correspondences, whatever share of
     /// theirs that is, kept with those alone: the links of two orbits whose true placement
@@ -1033,8 +1036,9 @@ fn links(
     let explained = |p: &usize, m: &BTreeSet<[u32; 2]>| {
         linking == Linking::Trimmed || m.len() as f64 >= PAIR_MIN_FRACTION * total[p] as f64
     };
-    let trimmed =
-        |m: &BTreeSet<[u32; 2]>| linking == Linking::Trimmed || m.len() >= DEFAULT_MIN_NUM_MATCHES;
+    let two_places = |p: &usize, m: &BTreeSet<[u32; 2]>| {
+        m.len() >= DEFAULT_MIN_NUM_MATCHES && total[p] - m.len() >= DEFAULT_MIN_NUM_MATCHES
+    };
     let mut out: Vec<Link> = (agreeing.into_iter())
         .filter(|(p, m)| m.len() >= PAIR_MIN_AGREEING && explained(p, m))
         .map(|(p, m)| {
@@ -1042,7 +1046,7 @@ fn links(
             let all = evidence
                 .matches
                 .get(&(first, second))
-                .filter(|_| trimmed(&m));
+                .filter(|_| linking == Linking::Trimmed || two_places(&p, &m));
             Link {
                 image1: pairs[p][0].clone(),
                 image2: pairs[p][1].clone(),

@@ -1289,8 +1289,9 @@ fn two_models_are_joined_where_the_true_matches_place_them_once_the_ghost_is_ref
 
 /// A pair the taken placement explains that holds matches of another place too (a street's
 /// pair that sees one building in both images and the next in one of them): the repair keeps
-/// it with only its agreeing matches where those alone are enough for a mapper to use the pair,
-/// whole where not (street 30-6303: kept whole, such pairs drew 12 cameras a building along).
+/// it with only its agreeing matches where both its agreeing and its other correspondences are
+/// enough for a mapper to use the pair, whole where not (street 30-6303: kept whole, such pairs
+/// drew 12 cameras a building along).
 #[test]
 fn a_link_is_kept_with_only_the_matches_its_placement_explains() {
     let (a, b, mut evidence) = hall_like();
@@ -1317,15 +1318,19 @@ fn a_link_is_kept_with_only_the_matches_its_placement_explains() {
     let joins = join::join_models(&pair, &evidence, &DEFAULT_SETTINGS, &[]).unwrap();
     assert_eq!(joins.joined.len(), 1, "{joins:?}");
     let links = &joins.joined[0].links;
-    let enough = |l: &&join::Link| l.agreeing >= DEFAULT_MIN_NUM_MATCHES;
-    assert!(links.iter().any(|l| enough(&l)), "{links:?}");
-    assert!(links.iter().any(|l| !enough(&l)), "{links:?}");
+    let enough = |n: usize| n >= DEFAULT_MIN_NUM_MATCHES;
+    let two_places = |l: &join::Link| enough(l.agreeing) && enough(l.correspondences - l.agreeing);
+    // Links of each kind: two places, one place the mapper can use, and too few alone.
+    assert!(links.iter().any(two_places), "{links:?}");
+    let one_place = |l: &&join::Link| enough(l.agreeing) && !two_places(l);
+    assert!(links.iter().any(|l| one_place(&l)), "{links:?}");
+    assert!(links.iter().any(|l| !enough(l.agreeing)), "{links:?}");
     for link in links {
         let key = (link.image1.clone(), link.image2.clone());
         let key = if key.0 < key.1 { key } else { (key.1, key.0) };
         let mut dropped = link.dropped.clone();
         dropped.sort_unstable();
-        let mut expected = match enough(&link) {
+        let mut expected = match two_places(link) {
             true => false_ones[&key].clone(),
             false => Vec::new(),
         };
