@@ -1022,9 +1022,24 @@ enum Linking {
     Trimmed,
 }
 
-/// The pairs that link two models under a placement (`linking`), most agreeing first: each
-/// with at least [`PAIR_MIN_AGREEING`] correspondences among `inliers`, and where kept
-/// trimmed, the pair's other matches (from the database) as [`Link::dropped`].
+impl Linking {
+    /// Whether a pair with `agreeing` of its `total` correspondences agreeing links the models.
+    fn links(self, agreeing: usize, total: usize) -> bool {
+        agreeing >= PAIR_MIN_AGREEING
+            && (self == Linking::Trimmed || agreeing as f64 >= PAIR_MIN_FRACTION * total as f64)
+    }
+
+    /// Whether such a link is kept with only its agreeing matches.
+    fn trims(self, agreeing: usize, total: usize) -> bool {
+        let two_places =
+            agreeing >= DEFAULT_MIN_NUM_MATCHES && total - agreeing >= DEFAULT_MIN_NUM_MATCHES;
+        self == Linking::Trimmed || two_places
+    }
+}
+
+/// The pairs that link two models under a placement (`linking`), most agreeing first, with
+/// their correspondences among `inliers`; for a link kept trimmed, the pair's other matches
+/// (from the database) as [`Link::dropped`].
 fn links(
     pairs: &[[String; 2]],
     c: &[Correspondence],
@@ -1033,29 +1048,24 @@ fn links(
     linking: Linking,
 ) -> Vec<Link> {
     let (total, agreeing) = per_pair(c, inliers);
-    let explained = |p: &usize, m: &BTreeSet<[u32; 2]>| {
-        linking == Linking::Trimmed || m.len() as f64 >= PAIR_MIN_FRACTION * total[p] as f64
-    };
-    let two_places = |p: &usize, m: &BTreeSet<[u32; 2]>| {
-        m.len() >= DEFAULT_MIN_NUM_MATCHES && total[p] - m.len() >= DEFAULT_MIN_NUM_MATCHES
-    };
     let mut out: Vec<Link> = (agreeing.into_iter())
-        .filter(|(p, m)| m.len() >= PAIR_MIN_AGREEING && explained(p, m))
+        .filter(|(p, m)| linking.links(m.len(), total[p]))
         .map(|(p, m)| {
-            let [first, second] = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
-            let all = evidence
-                .matches
-                .get(&(first, second))
-                .filter(|_| linking == Linking::Trimmed || two_places(&p, &m));
+            let mut dropped = Vec::new();
+            if linking.trims(m.len(), total[&p]) {
+                let [first, second] = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
+                let all = evidence.matches.get(&(first, second));
+                dropped = (all.into_iter().flatten())
+                    .filter(|x| !m.contains(*x))
+                    .copied()
+                    .collect();
+            }
             Link {
                 image1: pairs[p][0].clone(),
                 image2: pairs[p][1].clone(),
                 correspondences: total[&p],
                 agreeing: m.len(),
-                dropped: (all.into_iter().flatten())
-                    .filter(|x| !m.contains(*x))
-                    .copied()
-                    .collect(),
+                dropped,
             }
         })
         .collect();

@@ -2,6 +2,7 @@
 //! each seeing a random 60% of what is in view) and a ghosted one (two differently textured
 //! walls whose cameras were registered onto one place, joined by a shared object).
 
+use super::evidence::in_name_order;
 use super::join::ApartReason;
 use super::repair::{blames, ModelEvidence};
 use super::resection::{DOMINANT_SUPPORT, THIRD_PLACE_RATIO, THIRD_PLACE_SHARE};
@@ -1299,7 +1300,7 @@ fn a_link_is_kept_with_only_the_matches_its_placement_explains() {
     let crossing = |key: &(String, String)| in_a.contains(&key.0) != in_a.contains(&key.1);
     // The weakest linking pair keeps 9 true matches: too few for a mapper alone.
     let weakest = (evidence.matches.iter())
-        .filter(|(key, m)| crossing(key) && m.len() >= 15)
+        .filter(|(key, m)| crossing(key) && m.len() >= DEFAULT_MIN_NUM_MATCHES)
         .min_by_key(|(_, m)| m.len())
         .map(|(key, _)| key.clone())
         .unwrap();
@@ -1326,8 +1327,8 @@ fn a_link_is_kept_with_only_the_matches_its_placement_explains() {
     assert!(links.iter().any(|l| one_place(&l)), "{links:?}");
     assert!(links.iter().any(|l| !enough(l.agreeing)), "{links:?}");
     for link in links {
-        let key = (link.image1.clone(), link.image2.clone());
-        let key = if key.0 < key.1 { key } else { (key.1, key.0) };
+        let [first, second] = in_name_order(link.image1.clone(), link.image2.clone());
+        let key = (first, second);
         let mut dropped = link.dropped.clone();
         dropped.sort_unstable();
         let mut expected = match two_places(link) {
