@@ -4,7 +4,7 @@ the pairs between two models that hold at least 5 matches agreeing with one plac
 check tried for them are made valid again, trimmed to those matches (docs/check.md, "A piece's
 placement again": orbits whose true placement explains no pair).
 
-usage: PY scripts/lab/trimmed-links.py REPORT K DB OUT_DB
+usage: PY scripts/lab/trimmed-links.py [--keep_unplaced] REPORT K DB OUT_DB
 
   REPORT  a `check --report` JSON of the run (with --database_path; since session 60 its
           `apart` and `joins` list the placements `tried`); its first pair of models with any
@@ -14,6 +14,8 @@ usage: PY scripts/lab/trimmed-links.py REPORT K DB OUT_DB
   DB      the run's database (a prune's: pairs it invalidated come back from vgsel_backup);
           with `joins`, the next turn's database, which holds the links whole
   OUT_DB  the copy written; map it (`colmap mapper`, scripts/ci/colmap4.py map) and `eval` it
+  --keep_unplaced  keep too the matches with a keypoint on no point of its model: only the
+          correspondences that disagree are dropped (session 64: not enough on street 30-6303)
 
 A match agrees when its two keypoints lie on points of their models that the placement puts
 within 1% of the first model's spread (median distance to the centroid) of each other, as
@@ -39,25 +41,29 @@ def keypoint_points(rec):
 
 
 def main():
-    if len(sys.argv) != 5:
+    args = sys.argv[1:]
+    keep_unplaced = args[:1] == ["--keep_unplaced"]
+    args = args[keep_unplaced:]
+    if len(args) != 4:
         sys.exit(__doc__)
-    report, k, db_path, out = sys.argv[1:]
+    report, k, db_path, out = args
     r = json.load(open(report))
     shutil.copy(db_path, out)
     db = sqlite3.connect(out)
     if k == "joins":
         for join in r["joins"]:
             links = {(l["image1"], l["image2"]) for l in join["links"]}
-            trim(db, join["model_paths"], join["placement"], links)
+            trim(db, join["model_paths"], join["placement"], links, keep_unplaced)
     else:
         pair = [p for p in r["apart"] + r["joins"] if p.get("tried")][0]
-        trim(db, pair["model_paths"], pair["tried"][int(k)]["placement"], None)
+        trim(db, pair["model_paths"], pair["tried"][int(k)]["placement"], None, keep_unplaced)
     db.commit()
 
 
-def trim(db, model_paths, placement, links):
+def trim(db, model_paths, placement, links, keep_unplaced):
     """The pairs between the two models holding 5 or more matches that agree with placement
-    (only those in links, image of the first model first, where given) kept with just those."""
+    (only those in links, image of the first model first, where given) kept with just those,
+    and with keep_unplaced those with a keypoint on no point too."""
     scale, rotation = placement["scale"], np.array(placement["rotation"])
     translation = np.array(placement["translation"])
     a, b = (pycolmap.Reconstruction(p) for p in model_paths)
@@ -90,6 +96,8 @@ def trim(db, model_paths, placement, links):
                     moved = scale * rotation @ points_b[kb] + translation
                     if np.linalg.norm(moved - points_a[ka]) < tolerance:
                         agreeing.append([x, y])
+                elif keep_unplaced:
+                    agreeing.append([x, y])
             if len(agreeing) < 5:
                 continue
             if backup:
