@@ -1701,10 +1701,12 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
 }
 
 /// A misplaced image whose correspondences name a third place (a pose besides the model's and
-/// the matches' that [`THIRD_PLACE_SHARE`] of them agree with) is still misplaced, but the
-/// repair takes none of its pairs or matches: on a short street its best pose is one copy
-/// among several. Just under the share it does, and where the matches' pose holds
-/// [`DOMINANT_SUPPORT`] times the model's and the third's (a hall camera on the other orbit).
+/// the matches' that [`THIRD_PLACE_SHARE`] of them agree with) and that no pair holds where the
+/// model put it is still misplaced, but the repair takes none of its pairs or matches: on a
+/// short street its best pose is one copy among several. Just under the share it does, where
+/// the matches' pose holds [`DOMINANT_SUPPORT`] times the model's and the third's (a hall
+/// camera on the other orbit), and where a pair holds it where the model put it (a street
+/// camera in a repair turn's model).
 #[test]
 fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
     let placement = |elsewhere: usize| resection::ImagePlacement {
@@ -1716,7 +1718,7 @@ fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
         moved: 0.3,
         centre: [0.0; 3],
         links: vec![["c.png".into(), "b.png".into()]],
-        against: vec![["c.png".into(), "d.png".into()]],
+        against: Vec::new(),
         holding: vec![resection::PairMatches {
             images: ["c.png".into(), "b.png".into()],
             matches: vec![[3, 7]],
@@ -1742,8 +1744,19 @@ fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
     let (_, placed) = evidence(placement(at - 1));
     let named = |a: &str, b: &str| [a.to_string(), b.to_string()];
     assert_eq!(placed.links, [named("b.png", "c.png")]);
-    assert_eq!(placed.blamed, [named("c.png", "d.png")]);
+    assert!(placed.blamed.is_empty());
     assert_eq!(placed.dropped.len(), 1);
+    // A third place at the share, one pair holding the image where the model put it: placed,
+    // and that pair blamed.
+    let held = resection::ImagePlacement {
+        against: vec![named("c.png", "d.png")],
+        ..placement(at)
+    };
+    assert!(held.third_place() && !held.dominates());
+    let (_, taken) = evidence(held);
+    assert_eq!(taken.links, placed.links);
+    assert_eq!(taken.blamed, [named("c.png", "d.png")]);
+    assert_eq!(taken.dropped, placed.dropped);
     // A third place at the share, the matches' pose holding DOMINANT_SUPPORT times the model's
     // and the third's (the larger of the two, in turn): placed; one correspondence fewer: not.
     for (model_support, elsewhere) in [(100, at), (at, 100), (200, 200)] {

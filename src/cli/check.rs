@@ -226,15 +226,21 @@ fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
         m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
     );
     let third = format!("; {} more agree with a third pose", m.elsewhere);
-    match (m.third_place(), m.dominates()) {
-        (false, _) => text,
-        (true, true) => format!(
+    match (m.third_place(), m.dominates(), m.held_by_pairs()) {
+        (false, _, _) => text,
+        (true, true, _) => format!(
             "{text}{third}, but the matches' pose holds {:.1} times the model's and the third's: \
              the repair takes its pairs",
             m.dominance()
         ),
-        (true, false) => format!(
-            "{text}{third}: it matches a third place, and the repair takes none of its pairs"
+        (true, false, true) => format!(
+            "{text}{third}, but {} pairs hold it where the model put it: the repair takes its \
+             pairs",
+            m.against.len()
+        ),
+        (true, false, false) => format!(
+            "{text}{third}: it matches a third place, and no pair holds it where the model put \
+             it: the repair takes none of its pairs"
         ),
     }
 }
@@ -621,11 +627,12 @@ mod tests {
     }
 
     /// A misplaced image's line says what the repair does with its pairs: takes them where its
-    /// matches name no third place or their pose dominates it, else none.
+    /// matches name no third place, their pose dominates it or pairs hold the image where the
+    /// model put it, else none.
     #[test]
     fn a_misplaced_images_line_says_whether_the_repair_takes_its_pairs() {
-        let placed = |support: usize, model_support: usize, elsewhere: usize| {
-            misplaced_image_text(&check::resection::ImagePlacement {
+        let placement = |support: usize, model_support: usize, elsewhere: usize| {
+            check::resection::ImagePlacement {
                 image: "c.png".into(),
                 correspondences: 1000,
                 model_support,
@@ -636,7 +643,10 @@ mod tests {
                 links: vec![["c.png".into(), "b.png".into()]],
                 against: Vec::new(),
                 holding: Vec::new(),
-            })
+            }
+        };
+        let placed = |support: usize, model_support: usize, elsewhere: usize| {
+            misplaced_image_text(&placement(support, model_support, elsewhere))
         };
         let head = "; the database's matches place c.png 240% of the model's spread away";
         assert_eq!(
@@ -648,8 +658,8 @@ mod tests {
         );
         let refused = |elsewhere: usize| {
             format!(
-                "; {elsewhere} more agree with a third pose: it matches a third place, and the \
-                 repair takes none of its pairs"
+                "; {elsewhere} more agree with a third pose: it matches a third place, and no \
+                 pair holds it where the model put it: the repair takes none of its pairs"
             )
         };
         assert!(placed(500, 200, 100).ends_with(&refused(100)));
@@ -657,6 +667,17 @@ mod tests {
         assert!(placed(870, 300, 200).ends_with(
             "; 200 more agree with a third pose, but the matches' pose holds 2.9 times the \
              model's and the third's: the repair takes its pairs"
+        ));
+        let held = misplaced_image_text(&check::resection::ImagePlacement {
+            against: vec![
+                ["c.png".into(), "d.png".into()],
+                ["c.png".into(), "e.png".into()],
+            ],
+            ..placement(500, 200, 100)
+        });
+        assert!(held.ends_with(
+            "0 matches hold it there; 100 more agree with a third pose, but 2 pairs hold it \
+             where the model put it: the repair takes its pairs"
         ));
     }
 
