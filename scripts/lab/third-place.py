@@ -3,12 +3,17 @@
 their pairs (docs/check.md, "A third place the matches' pose dominates"): every run re-checked by
 this binary (`check --report`), each misplaced image with its correspondences, those the
 matches' pose, the model's pose and a third pose explain, its dominance (the matches' pose's
-support over the larger of the other two: `resection::DOMINANT_SUPPORT`) and the truth of its
-links (`eval --labels` on the loop's full database: exact for rendered scenes). A camera whose
-evidence repeats run after run (the same correspondences and support) is counted once.
+support over the larger of the other two: `resection::DOMINANT_SUPPORT`), the truth of its
+links and of its pairs against it (`eval --labels` on the loop's full database: exact for
+rendered scenes), and whether its model is a ghost of groups (whose misplaced images the repair
+does not act on: their split does). A camera whose evidence repeats run after run (the same
+correspondences and support) is counted once.
 
-Two tables: every camera, then the range of dominance and the links' truth per design, with and
-without a third place (`resection::THIRD_PLACE_SHARE` of the correspondences).
+Three tables: every camera; the range of dominance and the links' truth per design, with and
+without a third place (`resection::THIRD_PLACE_SHARE` of the correspondences); and the cameras
+with a third place outside ghosts of groups, by whether a pair holds them where the model put
+them (`ImagePlacement::held_by_pairs`) and by run (the full database's, the pruned one's, a
+repair turn's).
 
 usage: VGSEL=target/release/vgsel-colmap scripts/lab/third-place.py DIR...
        (DIR: folders holding pipeline.sh work folders, at any depth, each with its summary.json
@@ -32,6 +37,17 @@ def dominance(m):
     return m["support"] / max(m["model_support"], m["elsewhere"], 1)
 
 
+def ghost_of_groups(model):
+    """The model is a ghost of groups (`ModelCheck::ghost_of_groups`)."""
+    alone = any(len(g) == 1 for g in (model.get("worst") or {}).get("groups", []))
+    return model["ghosted"] and not alone and not model["ghost_of_images"]
+
+
+def run_kind(model):
+    """full, pruned or turn: which run of the loop a model folder (`sparse_VARIANT`) is."""
+    return {"sparse_full": "full", "sparse_pruned": "pruned"}.get(os.path.basename(model), "turn")
+
+
 def cameras(dirs, tmp):
     """One row per misplaced camera of every run below `dirs`, its evidence counted once."""
     seen, labels = set(), {}
@@ -50,8 +66,8 @@ def cameras(dirs, tmp):
                                 "--report", report], capture_output=True)
                 if not os.path.exists(report):
                     continue
-                for m in (i for mc in json.load(open(report))["models"]
-                          for i in mc.get("misplaced_images") or []):
+                for mc, m in ((mc, i) for mc in json.load(open(report))["models"]
+                              for i in mc.get("misplaced_images") or []):
                     key = (design, m["image"], m["correspondences"], m["support"])
                     if key in seen:
                         continue
@@ -59,6 +75,7 @@ def cameras(dirs, tmp):
                     if full_db not in labels:
                         labels[full_db] = colmap_files.named_pair_labels(full_db, gt, tmp)
                     truth = [labels[full_db].get(tuple(sorted(p))) for p in m["links"]]
+                    against = [labels[full_db].get(tuple(sorted(p))) for p in m["against"]]
                     yield {
                         "design": design.split("-")[0],
                         "scene": design,
@@ -70,6 +87,10 @@ def cameras(dirs, tmp):
                                    m["elsewhere"]),
                         "links_true": sum(bool(t) for t in truth),
                         "links": len(truth),
+                        "against_true": sum(bool(t) for t in against),
+                        "against": len(against),
+                        "ghost_of_groups": ghost_of_groups(mc),
+                        "kind": run_kind(model),
                     }
                 os.remove(report)
 
@@ -78,12 +99,13 @@ def main(dirs):
     with tempfile.TemporaryDirectory() as tmp:
         rows = list(cameras(dirs, tmp))
     print("| run | image | correspondences, matches', model's, third | third place | "
-          "dominance | links true |")
-    print("|---|---|---|---|---:|---|")
+          "dominance | links true | against true | ghost of groups |")
+    print("|---|---|---|---|---:|---|---|---|")
     for r in sorted(rows, key=lambda r: r["dominance"]):
         print(f"| {r['run']} | {r['image']} | {', '.join(map(str, r['counts']))} | "
               f"{'yes' if r['third'] else 'no'} | {r['dominance']:.2f} | "
-              f"{r['links_true']} of {r['links']} |")
+              f"{r['links_true']} of {r['links']} | {r['against_true']} of {r['against']} | "
+              f"{'yes' if r['ghost_of_groups'] else 'no'} |")
     print("\n| design | third place | cameras | scenes | dominance | links true |")
     print("|---|---|---:|---:|---|---|")
     for design in sorted({r["design"] for r in rows}):
@@ -95,6 +117,17 @@ def main(dirs):
             print(f"| {design} | {'yes' if third else 'no'} | {len(group)} | "
                   f"{len({r['scene'] for r in group})} | {lo:.2f}-{hi:.2f} | "
                   f"{sum(r['links_true'] for r in group)} of {sum(r['links'] for r in group)} |")
+    print("\n| third place, outside ghosts of groups | run | cameras | links true | against true |")
+    print("|---|---|---:|---|---|")
+    acted = [r for r in rows if r["third"] and not r["ghost_of_groups"]]
+    for held in (True, False):
+        for kind in ("full", "pruned", "turn"):
+            group = [r for r in acted if (r["against"] > 0) == held and r["kind"] == kind]
+            if group:
+                print(f"| {'pairs against it' if held else 'no pair against it'} | {kind} | "
+                      f"{len(group)} | {sum(r['links_true'] for r in group)} of "
+                      f"{sum(r['links'] for r in group)} | {sum(r['against_true'] for r in group)}"
+                      f" of {sum(r['against'] for r in group)} |")
 
 
 if __name__ == "__main__":
