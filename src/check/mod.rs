@@ -258,6 +258,20 @@ impl ModelCheck<'_> {
         let alone = self.worst.as_ref().is_some_and(Split::alone);
         self.ghosted && !alone && !self.ghost_of_images
     }
+
+    /// Whether the repair takes misplaced image `m`'s pairs: its matches' pose is where it
+    /// belongs ([`resection::ImagePlacement::places`]), or, the model's only misplaced image,
+    /// pairs hold it where the model put it ([`resection::ImagePlacement::held_by_pairs`])
+    /// though its matches name a third place. Short streets (sessions 64-65, docs/check.md, "A
+    /// misplaced image its pairs hold where the model put it"): such images alone in repair
+    /// turns' models had links 38 of 42 true, pairs against them 0 of 9; where other images of
+    /// the model were misplaced too, the model is likelier a ghost of copies its split misses
+    /// (links 15 of 44 true in full databases' models, 1 of 11 in street 30-6511's first turn,
+    /// 9 of 9 in 30-6506's, whose loop taking them turned worse). With it streets 30-6411,
+    /// 30-6417 and 36-6418 end with every camera right (29/30, 29/30 and 35/36 before).
+    pub fn takes(&self, m: &resection::ImagePlacement) -> bool {
+        m.places() || (m.held_by_pairs() && self.misplaced_images.len() == 1)
+    }
 }
 
 /// Checks one model, with the database's evidence if there is one (without: joining pairs are

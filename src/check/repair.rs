@@ -64,8 +64,7 @@ impl RunCheck<'_> {
             .models
             .iter()
             .filter(|c| !c.ghost_of_groups())
-            .flat_map(|c| &c.misplaced_images)
-            .filter(|m| m.places());
+            .flat_map(|c| c.misplaced_images.iter().filter(|m| c.takes(m)));
         for pair in images.clone().flat_map(|m| &m.against) {
             blamed.insert(pair.clone());
         }

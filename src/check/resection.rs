@@ -156,24 +156,18 @@ impl ImagePlacement {
             && self.support as f64 >= SUPPORT_RATIO * self.model_support as f64
     }
 
-    /// Its matches name no third place ([`ImagePlacement::third_place`]), their pose
-    /// dominates the others ([`ImagePlacement::dominates`]), or pairs hold it where the model
-    /// put it ([`ImagePlacement::held_by_pairs`]): where the image is misplaced, the matches'
-    /// pose is where it belongs.
+    /// Its matches name no third place ([`ImagePlacement::third_place`]), or their pose
+    /// dominates the others ([`ImagePlacement::dominates`]): where the image is misplaced,
+    /// the matches' pose is where it belongs. (Alone in its model, an image that pairs hold
+    /// where the model put it is too: [`super::ModelCheck::takes`].)
     pub fn places(&self) -> bool {
-        !self.third_place() || self.dominates() || self.held_by_pairs()
+        !self.third_place() || self.dominates()
     }
 
     /// Some of its pairs hold it where the model put it (`against`): its pairs take sides, a
     /// few with the model's pose and the rest with the matches'. Where none is against it, the
     /// model's pose rests on correspondences spread over pairs that agree with the matches'
-    /// pose, and that pose is one copy among several. Session 64's short streets (docs/check.md,
-    /// "A misplaced image its pairs hold where the model put it"): of the 13 misplaced cameras
-    /// with a third place in models no ghost of groups flagged, the 6 with pairs against them
-    /// had links 35 of 45 true (the 4 in repair turns' models 32 of 33), the 7 without 23 of
-    /// 61. Those turns redone with the repair taking the 4 cameras' pairs end with every camera
-    /// right: streets 30-6411, 30-6417 and 36-6418 (29/30, 29/30 and 35/36 before), and 36-6301
-    /// after a fourth turn.
+    /// pose, and that pose is one copy among several.
     pub fn held_by_pairs(&self) -> bool {
         !self.against.is_empty()
     }

@@ -1705,8 +1705,8 @@ fn a_ghost_without_a_placement_but_with_a_misplaced_image_is_repaired_as_that_im
 /// model put it is still misplaced, but the repair takes none of its pairs or matches: on a
 /// short street its best pose is one copy among several. Just under the share it does, where
 /// the matches' pose holds [`DOMINANT_SUPPORT`] times the model's and the third's (a hall
-/// camera on the other orbit), and where a pair holds it where the model put it (a street
-/// camera in a repair turn's model).
+/// camera on the other orbit), and where a pair holds it where the model put it and it is its
+/// model's only misplaced image (a street camera in a repair turn's model).
 #[test]
 fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
     let placement = |elsewhere: usize| resection::ImagePlacement {
@@ -1753,10 +1753,22 @@ fn a_misplaced_image_that_matches_a_third_place_gives_the_repair_nothing() {
         ..placement(at)
     };
     assert!(held.third_place() && !held.dominates());
-    let (_, taken) = evidence(held);
+    let (_, taken) = evidence(held.clone());
     assert_eq!(taken.links, placed.links);
     assert_eq!(taken.blamed, [named("c.png", "d.png")]);
     assert_eq!(taken.dropped, placed.dropped);
+    // Held so, but beside another misplaced image of its model: not placed.
+    let model = ModelCheck {
+        misplaced_images: vec![held.clone(), held],
+        ..ModelCheck::default()
+    };
+    assert!(!model.takes(&model.misplaced_images[0]));
+    let run = RunCheck {
+        models: vec![model],
+        joins: join::Joins::default(),
+        rejoined: Vec::new(),
+    };
+    assert_eq!(run.evidence(), ModelEvidence::default());
     // A third place at the share, the matches' pose holding DOMINANT_SUPPORT times the model's
     // and the third's (the larger of the two, in turn): placed; one correspondence fewer: not.
     for (model_support, elsewhere) in [(100, at), (at, 100), (200, 200)] {

@@ -164,7 +164,7 @@ fn verdict_line(dir: &Path, c: &ModelCheck, settings: &CheckSettings) -> String 
 fn images_text(c: &ModelCheck) -> String {
     let mut line = String::new();
     for m in &c.misplaced_images {
-        line += &misplaced_image_text(m);
+        line += &misplaced_image_text(m, c.misplaced_images.len() - 1);
     }
     if !c.neighbours_apart.is_empty() {
         let n = c.neighbours_apart.len();
@@ -205,8 +205,9 @@ fn images_text(c: &ModelCheck) -> String {
     line
 }
 
-/// Where the database's matches place one image, and the pairs for and against it.
-fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
+/// Where the database's matches place one image, and the pairs for and against it; `others`:
+/// the other images of its model so placed ([`ModelCheck::takes`]).
+fn misplaced_image_text(m: &check::resection::ImagePlacement, others: usize) -> String {
     // A pose far outside the model (RANSAC on few distant points) is no distance worth
     // printing.
     let distance = match m.moved {
@@ -226,19 +227,23 @@ fn misplaced_image_text(m: &check::resection::ImagePlacement) -> String {
         m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
     );
     let third = format!("; {} more agree with a third pose", m.elsewhere);
-    match (m.third_place(), m.dominates(), m.held_by_pairs()) {
-        (false, _, _) => text,
-        (true, true, _) => format!(
+    match (m.third_place(), m.dominates(), m.held_by_pairs(), others) {
+        (false, ..) => text,
+        (true, true, ..) => format!(
             "{text}{third}, but the matches' pose holds {:.1} times the model's and the third's: \
              the repair takes its pairs",
             m.dominance()
         ),
-        (true, false, true) => format!(
+        (true, false, true, 0) => format!(
             "{text}{third}, but {} pairs hold it where the model put it: the repair takes its \
              pairs",
             m.against.len()
         ),
-        (true, false, false) => format!(
+        (true, false, true, others) => format!(
+            "{text}{third}: it matches a third place, and {others} more images of the model are \
+             misplaced: the repair takes none of its pairs"
+        ),
+        (true, false, false, _) => format!(
             "{text}{third}: it matches a third place, and no pair holds it where the model put \
              it: the repair takes none of its pairs"
         ),
@@ -627,8 +632,8 @@ mod tests {
     }
 
     /// A misplaced image's line says what the repair does with its pairs: takes them where its
-    /// matches name no third place, their pose dominates it or pairs hold the image where the
-    /// model put it, else none.
+    /// matches name no third place, their pose dominates it or, alone in its model, pairs hold
+    /// the image where the model put it, else none.
     #[test]
     fn a_misplaced_images_line_says_whether_the_repair_takes_its_pairs() {
         let placement = |support: usize, model_support: usize, elsewhere: usize| {
@@ -646,7 +651,7 @@ mod tests {
             }
         };
         let placed = |support: usize, model_support: usize, elsewhere: usize| {
-            misplaced_image_text(&placement(support, model_support, elsewhere))
+            misplaced_image_text(&placement(support, model_support, elsewhere), 0)
         };
         let head = "; the database's matches place c.png 240% of the model's spread away";
         assert_eq!(
@@ -668,16 +673,21 @@ mod tests {
             "; 200 more agree with a third pose, but the matches' pose holds 2.9 times the \
              model's and the third's: the repair takes its pairs"
         ));
-        let held = misplaced_image_text(&check::resection::ImagePlacement {
+        let held = check::resection::ImagePlacement {
             against: vec![
                 ["c.png".into(), "d.png".into()],
                 ["c.png".into(), "e.png".into()],
             ],
             ..placement(500, 200, 100)
-        });
-        assert!(held.ends_with(
+        };
+        assert!(misplaced_image_text(&held, 0).ends_with(
             "0 matches hold it there; 100 more agree with a third pose, but 2 pairs hold it \
              where the model put it: the repair takes its pairs"
+        ));
+        assert!(misplaced_image_text(&held, 2).ends_with(
+            "0 matches hold it there; 100 more agree with a third pose: it matches a third \
+             place, and 2 more images of the model are misplaced: the repair takes none of its \
+             pairs"
         ));
     }
 
