@@ -1051,15 +1051,16 @@ fn links(
     let mut out: Vec<Link> = (agreeing.into_iter())
         .filter(|(p, m)| linking.links(m.len(), total[p]))
         .map(|(p, m)| {
-            let mut dropped = Vec::new();
-            if linking.trims(m.len(), total[&p]) {
+            let dropped = if linking.trims(m.len(), total[&p]) {
                 let [first, second] = in_name_order(pairs[p][0].clone(), pairs[p][1].clone());
                 let all = evidence.matches.get(&(first, second));
-                dropped = (all.into_iter().flatten())
+                (all.into_iter().flatten())
                     .filter(|x| !m.contains(*x))
                     .copied()
-                    .collect();
-            }
+                    .collect()
+            } else {
+                Vec::new()
+            };
             Link {
                 image1: pairs[p][0].clone(),
                 image2: pairs[p][1].clone(),

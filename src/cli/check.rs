@@ -164,7 +164,7 @@ fn verdict_line(dir: &Path, c: &ModelCheck, settings: &CheckSettings) -> String 
 fn images_text(c: &ModelCheck) -> String {
     let mut line = String::new();
     for m in &c.misplaced_images {
-        line += &misplaced_image_text(m, c.misplaced_images.len() - 1);
+        line += &misplaced_image_text(m, c);
     }
     if !c.neighbours_apart.is_empty() {
         let n = c.neighbours_apart.len();
@@ -205,9 +205,10 @@ fn images_text(c: &ModelCheck) -> String {
     line
 }
 
-/// Where the database's matches place one image, and the pairs for and against it; `others`:
-/// the other images of its model so placed ([`ModelCheck::takes`]).
-fn misplaced_image_text(m: &check::resection::ImagePlacement, others: usize) -> String {
+/// Where the database's matches place one image of model `c`, the pairs for and against it,
+/// and, where they name a third place, why the repair takes its pairs or not
+/// ([`ModelCheck::takes`]).
+fn misplaced_image_text(m: &check::resection::ImagePlacement, c: &ModelCheck) -> String {
     // A pose far outside the model (RANSAC on few distant points) is no distance worth
     // printing.
     let distance = match m.moved {
@@ -226,28 +227,30 @@ fn misplaced_image_text(m: &check::resection::ImagePlacement, others: usize) -> 
         m.against.len(),
         m.holding.iter().map(|h| h.matches.len()).sum::<usize>()
     );
-    let third = format!("; {} more agree with a third pose", m.elsewhere);
-    match (m.third_place(), m.dominates(), m.held_by_pairs(), others) {
-        (false, ..) => text,
-        (true, true, ..) => format!(
-            "{text}{third}, but the matches' pose holds {:.1} times the model's and the third's: \
-             the repair takes its pairs",
-            m.dominance()
-        ),
-        (true, false, true, 0) => format!(
-            "{text}{third}, but {} pairs hold it where the model put it: the repair takes its \
-             pairs",
-            m.against.len()
-        ),
-        (true, false, true, others) => format!(
-            "{text}{third}: it matches a third place, and {others} more images of the model are \
-             misplaced: the repair takes none of its pairs"
-        ),
-        (true, false, false, _) => format!(
-            "{text}{third}: it matches a third place, and no pair holds it where the model put \
-             it: the repair takes none of its pairs"
-        ),
+    if !m.third_place() {
+        return text;
     }
+    let third = format!("; {} more agree with a third pose", m.elsewhere);
+    let why = if m.dominates() {
+        format!(
+            ", but the matches' pose holds {:.1} times the model's and the third's",
+            m.dominance()
+        )
+    } else if !m.held_by_pairs() {
+        ": it matches a third place, and no pair holds it where the model put it".to_string()
+    } else if c.takes(m) {
+        format!(
+            ", but {} pairs hold it where the model put it",
+            m.against.len()
+        )
+    } else {
+        format!(
+            ": it matches a third place, and {} more images of the model are misplaced",
+            c.misplaced_images.len() - 1
+        )
+    };
+    let takes = if c.takes(m) { "its" } else { "none of its" };
+    format!("{text}{third}{why}: the repair takes {takes} pairs")
 }
 
 /// Where the database's matches place a model's second group, and the pairs that link it.
@@ -650,8 +653,16 @@ mod tests {
                 holding: Vec::new(),
             }
         };
+        // `m` with `others` more misplaced images in its model.
+        let in_model = |m: &check::resection::ImagePlacement, others: usize| {
+            let c = ModelCheck {
+                misplaced_images: vec![m.clone(); others + 1],
+                ..ModelCheck::default()
+            };
+            misplaced_image_text(m, &c)
+        };
         let placed = |support: usize, model_support: usize, elsewhere: usize| {
-            misplaced_image_text(&placement(support, model_support, elsewhere), 0)
+            in_model(&placement(support, model_support, elsewhere), 0)
         };
         let head = "; the database's matches place c.png 240% of the model's spread away";
         assert_eq!(
@@ -680,11 +691,11 @@ mod tests {
             ],
             ..placement(500, 200, 100)
         };
-        assert!(misplaced_image_text(&held, 0).ends_with(
+        assert!(in_model(&held, 0).ends_with(
             "0 matches hold it there; 100 more agree with a third pose, but 2 pairs hold it \
              where the model put it: the repair takes its pairs"
         ));
-        assert!(misplaced_image_text(&held, 2).ends_with(
+        assert!(in_model(&held, 2).ends_with(
             "0 matches hold it there; 100 more agree with a third pose: it matches a third \
              place, and 2 more images of the model are misplaced: the repair takes none of its \
              pairs"
