@@ -178,6 +178,18 @@ def turn_models(work, variant):
     return (parameters.get("earlier_model") or []) + (parameters.get("model") or [])
 
 
+def model_state(m):
+    """A `check --report` model as the repair treats its misplaced images: "clean model" (not
+    ghosted), "image alone" (a ghost whose split leaves one image alone), "ghost of images"
+    (its misplaced images are the ghost) or "ghost of groups" (`ModelCheck::ghost_of_groups`:
+    the repair acts by its split alone)."""
+    if not m["ghosted"]:
+        return "clean model"
+    if any(len(g) == 1 for g in (m.get("worst") or {}).get("groups", [])):
+        return "image alone"
+    return "ghost of images" if m["ghost_of_images"] else "ghost of groups"
+
+
 def pipeline_runs(top):
     """(model folder, its database, eval report) of every run of every scripts/pipeline.sh work
     folder under `top`, at any depth (one with an `eval_full.json`): full, pruned and

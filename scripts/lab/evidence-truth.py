@@ -60,9 +60,7 @@ def sourced_pairs(report):
         for source in ("ghost_placement", "misplaced"):
             for link in (m.get(source) or {}).get("links", []):
                 yield f"{source} link", key(link["image1"], link["image2"])
-        alone = any(len(g) == 1 for g in m["worst"]["groups"]) if m["worst"] else False
-        state = ("clean model" if not m["ghosted"] else "image alone" if alone else
-                 "ghost of images" if m["ghost_of_images"] else "ghost of groups")
+        state = colmap_files.model_state(m)
         for image in m["misplaced_images"]:
             for a, b in image["links"]:
                 yield f"misplaced_image link, {state}", key(a, b)

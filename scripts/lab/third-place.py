@@ -37,12 +37,6 @@ def dominance(m):
     return m["support"] / max(m["model_support"], m["elsewhere"], 1)
 
 
-def ghost_of_groups(model):
-    """The model is a ghost of groups (`ModelCheck::ghost_of_groups`)."""
-    alone = any(len(g) == 1 for g in (model.get("worst") or {}).get("groups", []))
-    return model["ghosted"] and not alone and not model["ghost_of_images"]
-
-
 def run_kind(model):
     """full, pruned or turn: which run of the loop a model folder (`sparse_VARIANT`) is."""
     return {"sparse_full": "full", "sparse_pruned": "pruned"}.get(os.path.basename(model), "turn")
@@ -89,7 +83,7 @@ def cameras(dirs, tmp):
                         "links": len(truth),
                         "against_true": sum(bool(t) for t in against),
                         "against": len(against),
-                        "ghost_of_groups": ghost_of_groups(mc),
+                        "ghost_of_groups": colmap_files.model_state(mc) == "ghost of groups",
                         "kind": run_kind(model),
                     }
                 os.remove(report)
