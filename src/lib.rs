@@ -21,3 +21,4 @@ pub mod outputs;
 pub mod priors;
 pub mod scene;
 pub mod selection;
+pub mod stats;

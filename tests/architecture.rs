@@ -392,3 +392,12 @@ fn long_functions_finds_a_long_unmarked_function() {
         [(2, "long".to_string(), MAX_FN_LINES + 1)]
     );
 }
+
+#[test]
+fn stats_is_a_leaf() {
+    forbid(
+        &["src/stats.rs"],
+        &["crate::", "nalgebra", "rusqlite", "opencv"],
+        "stats holds what several layers share and uses none of them (ARCHITECTURE.md)",
+    );
+}

@@ -35,6 +35,7 @@ use crate::colmap::model::ModelImage;
 use crate::colmap::sparse::{SparseImage, SparseModel};
 use crate::colmap::DEFAULT_MIN_NUM_MATCHES;
 use crate::geometry::similarity::Similarity;
+use crate::stats::median;
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -314,7 +315,7 @@ impl Glued {
         let off = b_here.iter().zip(&b_ghost).map(|(here, ghost)| {
             (to_ghost.apply(&placement.apply(&here.centre())) - ghost.centre()).norm()
         });
-        Some(median(off) / self.spread())
+        median(off).map(|m| m / self.spread())
     }
 
     /// Whether a pose of `image` with camera centre `centre` in `model`'s frame puts it where
@@ -878,11 +879,8 @@ fn spread(model: &SparseModel) -> f64 {
 /// The median distance of `points` to their centroid (0 without points): the scale the check's
 /// distances are measured in.
 pub(super) fn spread_of(points: &[Vector3<f64>]) -> f64 {
-    if points.is_empty() {
-        return 0.0;
-    }
-    let centroid = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
-    median(points.iter().map(|p| (p - centroid).norm()))
+    let centroid = points.iter().sum::<Vector3<f64>>() / points.len().max(1) as f64;
+    median(points.iter().map(|p| (p - centroid).norm())).unwrap_or(0.0)
 }
 
 /// How far placements `p` and `q` put `model`'s points from each other (median).
@@ -891,16 +889,7 @@ fn apart(model: &SparseModel, p: &Similarity, q: &Similarity) -> f64 {
         let x = Vector3::new(x[0], x[1], x[2]);
         (p.apply(&x) - q.apply(&x)).norm()
     }))
-}
-
-/// The median of `values` (the upper one of an even count; 0 for none).
-fn median(values: impl Iterator<Item = f64>) -> f64 {
-    let mut v: Vec<f64> = values.collect();
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mid = v.len() / 2;
-    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+    .unwrap_or(0.0)
 }
 
 /// The similarity (second model's frame -> first's) most of the `remaining` correspondences
@@ -950,7 +939,7 @@ fn ransac(
 fn degenerate(c: &[Correspondence], inliers: &[usize], tolerance: f64) -> bool {
     let targets = inliers.iter().map(|&k| c[k].1);
     let centroid = targets.clone().sum::<Vector3<f64>>() / inliers.len().max(1) as f64;
-    median(targets.map(|t| (t - centroid).norm())) <= DEGENERATE_EXTENT * tolerance
+    median(targets.map(|t| (t - centroid).norm())).unwrap_or(0.0) <= DEGENERATE_EXTENT * tolerance
 }
 
 /// Model `a` with `b`'s images (those `a` lacks) and points carried into `a`'s frame by

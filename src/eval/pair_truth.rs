@@ -24,6 +24,7 @@ use crate::eval::render::Scene;
 use crate::eval::surface_truth::{transfer_error, TRANSFER_THRESHOLD_PX};
 use crate::geometry::camera::CameraModel;
 use crate::geometry::pose::{sampson_distance, triangulate};
+use crate::stats::median;
 use anyhow::{ensure, Context, Result};
 use nalgebra::{Rotation3, Vector3};
 use petgraph::unionfind::UnionFind;
@@ -204,15 +205,6 @@ impl Judge {
     }
 }
 
-/// The median of `errors` (infinite when empty).
-fn median(mut errors: Vec<f64>) -> f64 {
-    errors.sort_by(f64::total_cmp);
-    errors
-        .get(errors.len() / 2)
-        .copied()
-        .unwrap_or(f64::INFINITY)
-}
-
 /// The judge of ground truth `gt`, and the median error in pixels of each of the database's
 /// verified pairs (as originally verified) under it, or None when an image is not in the
 /// ground truth; keyed by pair_id.
@@ -248,7 +240,7 @@ fn pair_errors(db: &Database, gt: &Path) -> Result<(Judge, HashMap<u64, Option<f
         }
         let x = [&keypoints[&ids[0]][..], &keypoints[&ids[1]][..]];
         let errors = judge.inlier_errors([p1, p2], x, &pair.inliers, focal);
-        labels.insert(pid, Some(median(errors)));
+        labels.insert(pid, Some(median(errors).unwrap_or(f64::INFINITY)));
     }
     Ok((judge, labels))
 }

@@ -7,6 +7,7 @@
 use crate::colmap::model;
 use crate::colmap::sparse;
 use crate::eval::align::{self, POSITION_TOLERANCE, ROTATION_TOLERANCE_DEG};
+use crate::stats::median;
 use anyhow::{ensure, Result};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -95,18 +96,14 @@ pub fn score(sparse: &Path, ground_truth: &Path) -> Result<Scores> {
     }
     let mut images: Vec<ImageScore> = best.into_values().collect();
     images.sort_by(|a, b| a.name.cmp(&b.name));
-    let median = |mut v: Vec<f64>| -> Option<f64> {
-        v.sort_by(f64::total_cmp);
-        (!v.is_empty()).then(|| v[v.len() / 2])
-    };
     Ok(Scores {
         models: dirs.len(),
         images_ground_truth: truth.len(),
         registered: images.len(),
         correct: images.iter().filter(|s| s.correct).count(),
         wrong_registrations,
-        median_position_error: median(images.iter().map(|s| s.position_error).collect()),
-        median_rotation_error_deg: median(images.iter().map(|s| s.rotation_error_deg).collect()),
+        median_position_error: median(images.iter().map(|s| s.position_error)),
+        median_rotation_error_deg: median(images.iter().map(|s| s.rotation_error_deg)),
         observations,
         images,
     })

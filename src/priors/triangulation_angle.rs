@@ -7,6 +7,7 @@ use super::values::{Prior, PriorValues};
 use crate::geometry::pose::{direction_angle_deg, triangulate};
 use crate::geometry::view_geometry::ViewGeometry;
 use crate::scene::Scene;
+use crate::stats::median;
 use rayon::prelude::*;
 
 /// Median triangulation angle (degrees) of each edge's inliers; 0 without a pose or points.
@@ -20,28 +21,18 @@ pub fn compute(scene: &Scene, geometry: &ViewGeometry) -> PriorValues {
             let (x1, x2) = geometry.edge_points(scene, edge);
             let t = pose.translation.into_inner();
             let c2 = pose.centre2();
-            let mut angles: Vec<f64> = x1
+            let angles = x1
                 .iter()
                 .zip(&x2)
                 .filter_map(|(a, b)| triangulate(&pose.rotation, &t, a, b))
-                .map(|x| direction_angle_deg(&x, &(x - c2)))
-                .collect();
-            median(&mut angles)
+                .map(|x| direction_angle_deg(&x, &(x - c2)));
+            median(angles).unwrap_or(0.0)
         })
         .collect();
     PriorValues {
         prior: Prior::TriangulationAngle,
         values,
     }
-}
-
-/// Median (upper for even counts); 0 for no values.
-pub fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    let mid = values.len() / 2;
-    *values.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 #[cfg(test)]
@@ -76,12 +67,5 @@ mod tests {
             })
             .collect();
         assert!(a.iter().all(|&d| d > 5.0 && d < 40.0), "{a:?}");
-    }
-
-    #[test]
-    fn median_of_odd_and_even() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 3.0);
-        assert_eq!(median(&mut []), 0.0);
     }
 }
